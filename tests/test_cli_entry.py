@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import re
 import signal
 from pathlib import Path
 
@@ -113,3 +114,66 @@ def test_an_empty_path_is_refused_naming_its_option_not_taken_as_the_current_fol
     err = capsys.readouterr().err
     assert "expected a path, got" in err
     assert list(tmp_path.iterdir()) == []  # nothing written
+
+
+@pytest.mark.parametrize(("argv", "dests"), [
+    (["report", "a.uff", "--out=~/rep", "--store=~/s.h5", "--dem-store=~/d.h5"],
+     ["out", "store", "dem_store"]),
+    (["model", "damper", "--out=~/d"], ["out"]),
+    (["calibrate", "--data=~/m.csv", "--out=~/c", "--dem-store=~/c.h5"],
+     ["data", "out", "dem_store"]),
+    (["analyze", "~/a.uff", "--store=~/x.h5", "--sidecar=~/l.csv"], ["store", "sidecar"]),
+    (["dem", "run", "--frequency", "500", "--acceleration", "5", "--fill", "50",
+      "--store=~/x.h5", "--specimen=~/s.toml"], ["store", "specimen"]),
+    (["app", "--store=~/x.h5"], ["store"]),
+])
+def test_a_leading_tilde_in_any_path_option_is_the_home_folder(argv, dests, monkeypatch,
+                                                                 tmp_path):
+    # --out=~/d (no shell expansion after '=') wrote into ./~/d (model damper, calibrate),
+    # dem run --store=~/x.h5 was refused as "directory ~ does not exist", report --out made
+    # ./~ and then failed in pandas (which expands ~ itself); only the app expanded it
+    monkeypatch.setenv("HOME", str(tmp_path))
+    args = build_parser().parse_args(argv)
+    for dest in dests:
+        value = getattr(args, dest)
+        value = value[0] if isinstance(value, list) else value  # report's --dem-store: several
+        assert value.parent == tmp_path and not str(value).startswith("~"), (dest, value)
+    if argv[0] == "analyze":
+        assert args.paths == [tmp_path / "a.uff"]
+
+
+def test_every_path_option_takes_the_one_path_rule():
+    # one rule for every path option: an option typed by hand would expand ~ (or not) its way
+    from pidcore.cli._options import path_argument
+
+    paths = [(parser.prog, action.option_strings or action.dest)
+             for parser in _all_parsers(build_parser()) for action in parser._actions
+             if re.fullmatch(r"FILE|DIR|PATH|CSV|TABLE\.csv|.*\.(h5|csv|json|toml)",
+                             str(action.metavar or "")) and action.type is not path_argument]
+    # kept specimen files are named by a sha256 or their path in the kept folder
+    assert paths == [("pidcore specimen kept", "files")]
+
+
+def test_a_tilde_of_no_such_user_is_refused_not_made_a_folder(capsys, tmp_path, monkeypatch):
+    from pidcore.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SystemExit) as done:
+        main(["model", "damper", "--out=~no_such_user_pidcore/d"])
+    assert done.value.code == 2
+    err = capsys.readouterr().err
+    assert "argument --out: ~no_such_user_pidcore/d: cannot expand ~no_such_user_pidcore" in err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_model_damper_out_with_a_tilde_writes_into_the_home_folder(capsys, tmp_path,
+                                                                   monkeypatch):
+    from pidcore.cli import main
+
+    home, work = tmp_path / "home", tmp_path / "work"
+    home.mkdir()
+    work.mkdir()
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.chdir(work)
+    assert main(["model", "damper", "--out=~/damper"]) == 0
+    assert (home / "damper").is_dir() and list(work.iterdir()) == []

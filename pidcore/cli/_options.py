@@ -36,10 +36,22 @@ def _whole_number(text: str, minimum: int) -> int:
 
 def path_argument(text: str) -> Path:
     """argparse type: a file or folder path, refused when empty (``--dem-store ""`` from an
-    unset shell variable was taken as the current folder: ".: is a folder")."""
+    unset shell variable was taken as the current folder: ".: is a folder").
+
+    A leading ``~`` or ``~user`` is expanded, as the shell does for ``--out ~/x`` but not for
+    ``--out=~/x`` or a quoted ``"~/x"``: those made a folder ``./~`` (``model damper``,
+    ``calibrate``), were refused as "directory ~ does not exist" (``dem run --store``) or
+    expanded by pandas alone (``report --out``), and ``pidcore app --store`` expanded it. A
+    ``~user`` of no such user is refused, not made a folder of that name."""
     if not text.strip():
         raise argparse.ArgumentTypeError(f"expected a path, got {text!r}")
-    return Path(text)
+    expanded = os.path.expanduser(text)
+    if expanded == text and text.startswith("~"):
+        head = text.split("/", 1)[0]
+        raise argparse.ArgumentTypeError(
+            f"{text}: cannot expand {head} (no such user, or no home folder); expected ~/PATH, "
+            f"~USER/PATH of a user of this system, or ./{text} for a folder named {head}")
+    return Path(expanded)
 
 
 def positive_int(text: str) -> int:
