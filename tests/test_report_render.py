@@ -798,3 +798,63 @@ def test_latex_writes_a_name_past_latin1_so_that_pdflatex_reads_it(tmp_path, pro
                      r"\[2\]\{#2\}\s+\\else\s+\\usepackage\[utf8\]\{inputenc\}\s+"
                      r"\\usepackage\[T1\]\{fontenc\}\s+\\newcommand\{\\pidcorechar\}\[2\]"
                      r"\{\\texttt\{\[U\+#1\]\}\}\s+\\fi", preamble)
+
+
+def _pdf_placed_text(data: bytes) -> list[tuple[float, float, float, str]]:
+    """Each text object of a matplotlib PDF: the x and y (pt from the page's left and bottom
+    edges) of its baseline's start, its font size and its text (its literal strings;
+    matplotlib places each line of a text on its own, ``1 0 -0 1 x y cm`` before its
+    ``BT``)."""
+    import zlib
+
+    out = []
+    for stream in re.finditer(rb"stream\r?\n(.*?)endstream", data, re.S):
+        unpack = zlib.decompressobj()
+        try:
+            content = unpack.decompress(stream.group(1))
+        except zlib.error:
+            continue
+        for x, y, size, block in re.findall(
+                rb"1 0 -?0 1 (-?[0-9.]+) (-?[0-9.]+) cm\s+BT\s+/F\d+ ([0-9.]+) Tf(.*?)ET",
+                content, re.S):
+            strings = re.findall(rb"\((.*?)(?<!\\)\)", block, re.S)
+            text = b"".join(re.sub(rb"\\([()\\])", rb"\1", s) for s in strings)
+            out.append((float(x), float(y), float(size), text.decode("latin-1")))
+    return out
+
+
+def test_pdf_shared_line_is_wrapped_to_the_page_and_keeps_the_whole_sha256(tmp_path,
+                                                                           provenance):
+    """The line of what every row shares was wrapped at 200 characters where ~145 fit A4
+    landscape at 10 pt: an own specimen's material, direction, settings, name and sha256 ran
+    past both edges of the page, the sha256 (written nowhere else in the PDF) losing its last
+    digits. Each line of the title is now measured: the whole sha256 is on one line, and
+    every line starts and ends on the page (its width measured in the font the PDF embeds),
+    a long name's lines too."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import text_to_path
+
+    from pidcore.report.render import _PDF_PAGE
+
+    sha = "296c220d8209d22bc0278b69f122274ac239d783c35f2bbe672b36d1cee67bcd"
+    for name in ("steel_6mm_aluminium_honeycomb_2mm_spheres", "honeycomb " * 60):
+        table = _two_settings_table().iloc[:2].copy()
+        table["material"] = "steel"
+        table["DEM settings"] = "cells 2, steady cycles 20, settings hash 60eac2"
+        table["specimen"] = name
+        table["specimen sha256"] = sha
+        out = tmp_path / name[:10].strip()
+        placed = _pdf_placed_text(write_report(table, {}, provenance, out, "pdf")["pdf"]
+                                  .read_bytes())
+        with_sha = [p for p in placed if sha in p[3]]
+        assert with_sha, "the whole sha256 on one line"
+        # the title's size (the table's is 6.5); a line of a glyph the PDF's font subset
+        # numbers below 32 (its "fi" of "Specific") is the fixed title, not measured here
+        titles = [p for p in placed if p[2] == 10.0 and min(map(ord, p[3])) >= 32]
+        assert any("Every row" in p[3] for p in titles) and with_sha[0] in titles
+        for x, y, size, text in titles:
+            width = text_to_path.get_text_width_height_descent(
+                text, FontProperties(size=size), ismath=False)[0]
+            # the PDF sets the advances and kerning matplotlib measures: 0.5 pt of slack
+            assert 0.0 <= x and x + width <= _PDF_PAGE[0] * 72 + 0.5, (x, width, text)
+            assert 0.0 <= y and y + size <= _PDF_PAGE[1] * 72, (y, text)

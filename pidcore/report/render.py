@@ -467,7 +467,9 @@ def pdf_shared_line(table: pd.DataFrame) -> str:
         if column in table.columns and column not in differing_columns(table):
             values = {v for v in table[column] if isinstance(v, str) and v}
             if values:
-                parts.append(f"{column} {values.pop()}")
+                # cut as in the table's cells: a specimen or material named at 4 KiB would
+                # take the page (a sha256's 64 digits are kept whole)
+                parts.append(f"{column} {bounded_stem(values.pop(), _PDF_CELL_MOST)}")
     return f"Every row that states it: {'; '.join(parts)}" if parts else ""
 
 
@@ -504,6 +506,65 @@ _PDF_NOTE_LINE = 6 / 72 * 1.25
 _PDF_TABLE_ROOM = 6.9
 #: Characters of a line of a note under the PDF table.
 _PDF_NOTE_WIDTH = 190
+#: The PDF table page's title: its size (pt), line height (in, matplotlib's 1.2 spacing) and
+#: gap to the table (``axes.titlepad``, 6 pt); the table's axes span the page's width between
+#: ``left`` and ``right`` and reach up to ``top`` (fractions of the page) where the title
+#: leaves room, its lines centred over them: a line is wrapped to the axes' width, so it never
+#: reaches past the page's edges (wrapped at 200 characters, ~145 fit the page, a specimen's
+#: sha256 lost its last digits at the right edge and "Every row" its first at the left).
+_PDF_TITLE_SIZE = 10.0
+_PDF_TITLE_LINE = _PDF_TITLE_SIZE / 72 * 1.2
+_PDF_TITLE_PAD = 6 / 72
+_PDF_AXES = {"left": 0.125, "right": 0.9, "top": 0.88}
+#: Inches kept free above the title's first line.
+_PDF_TOP_MARGIN = 0.3
+
+
+def _text_width(text: str, size: float) -> float:
+    """Points ``text`` takes at ``size`` pt in matplotlib's default font (its glyphs'
+    advances and kerning, as the PDF sets them)."""
+    from matplotlib.font_manager import FontProperties
+    from matplotlib.textpath import text_to_path
+
+    return text_to_path.get_text_width_height_descent(text, FontProperties(size=size),
+                                                      ismath=False)[0]
+
+
+def wrap_to_width(text: str, width: float, size: float) -> list[str]:
+    """``text`` in lines of at most ``width`` points at ``size`` pt, broken at its spaces, a
+    word wider than a line on its own (a long name) inside it."""
+    lines: list[str] = []
+    line = ""
+    for word in text.split():
+        joined = f"{line} {word}" if line else word
+        if _text_width(joined, size) <= width:
+            line = joined
+            continue
+        if line:
+            lines.append(line)
+        while _text_width(word, size) > width:
+            cut = 1
+            while cut < len(word) and _text_width(word[:cut + 1], size) <= width:
+                cut += 1
+            lines.append(word[:cut])
+            word = word[cut:]
+        line = word
+    return lines + ([line] if line else [])
+
+
+def _pdf_title_lines(title: str, shared: str) -> list[str]:
+    """The PDF table page's title and :func:`pdf_shared_line` under it, each wrapped to the
+    table's axes' width (:data:`_PDF_AXES`)."""
+    width = (_PDF_AXES["right"] - _PDF_AXES["left"]) * _PDF_PAGE[0] * 72
+    return [line for text in (title, shared) if text
+            for line in wrap_to_width(text, width, _PDF_TITLE_SIZE)]
+
+
+def _pdf_axes_top(title_lines: int) -> float:
+    """The top of the PDF table's axes (fraction of the page): :data:`_PDF_AXES`'s, lower
+    where the title's lines would reach within :data:`_PDF_TOP_MARGIN` of the page's top."""
+    title = _PDF_TOP_MARGIN + title_lines * _PDF_TITLE_LINE + _PDF_TITLE_PAD
+    return min(_PDF_AXES["top"], 1 - title / _PDF_PAGE[1])
 
 
 def _note_lines(number: int, note: str) -> list[str]:
@@ -511,10 +572,10 @@ def _note_lines(number: int, note: str) -> list[str]:
 
 
 def _pdf_pages(rows: list[list[str]], marks: list[str], notes: list[str],
-               header_lines: int) -> list[range]:
+               header_lines: int, room: float = _PDF_TABLE_ROOM) -> list[range]:
     """The rows of each page of the PDF table: as many as fit with the notes they number
-    (each page lists the notes of its own rows under its table)."""
-    room = _PDF_TABLE_ROOM - _pdf_row_height(header_lines)
+    (each page lists the notes of its own rows under its table) in ``room`` inches."""
+    room -= _pdf_row_height(header_lines)
     pages: list[range] = []
     start, used, listed = 0, 0.0, set()
     for i, row in enumerate(rows):
@@ -551,12 +612,19 @@ def _write_pdf(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenanc
         else ([""] * len(rows), [])
     shared = pdf_shared_line(table)
     header_lines = max(label.count("\n") + 1 for label in labels)
+    # "(continued)" may take a line more
+    titles = [_pdf_title_lines(t, shared) for t in (_TITLE, f"{_TITLE} (continued)")]
+    top = _pdf_axes_top(max(map(len, titles)))
+    # the table's room less what a long title took of the page
+    room = _PDF_TABLE_ROOM - (_PDF_AXES["top"] - top) * _PDF_PAGE[1]
     with PdfPages(path) as pdf:
-        for n, page in enumerate(_pdf_pages(rows, marks, notes, header_lines)):
+        for n, page in enumerate(_pdf_pages(rows, marks, notes, header_lines, room)):
             fig, ax = plt.subplots(figsize=_PDF_PAGE)
+            fig.subplots_adjust(left=_PDF_AXES["left"], right=_PDF_AXES["right"], top=top)
             ax.axis("off")
-            title = _TITLE if n == 0 else f"{_TITLE} (continued)"
-            ax.set_title("\n".join([title, *textwrap.wrap(shared, 200)]), fontsize=10)
+            # parse_math off: a "$" of a specimen's name is text, and measured as such
+            ax.set_title("\n".join(titles[min(n, 1)]), fontsize=_PDF_TITLE_SIZE,
+                         parse_math=False)
             chunk = [rows[i] for i in page] or [[""] * len(labels)]
             tab = ax.table(cellText=chunk, colLabels=labels, loc="upper center",
                            cellLoc="right")
