@@ -682,7 +682,7 @@ def test_pdf_table_tells_rows_of_one_load_case_apart_and_numbers_their_notes(tmp
     assert numbered_notes(table["note"]) == (["", "", "1"], [note])
     text = _pdf_text(write_report(table, {}, provenance, tmp_path / "r", "pdf")["pdf"]
                      .read_bytes())
-    assert "Every row that states it: material acrylic; direction z" in text
+    assert "Every row: material acrylic; direction z" in text
     assert "cells 2" in text and "cells 8" in text
     # up to "difference": the PDF draws its "ff" as a glyph of its own, not a letter of the text
     assert "1. the paper's Table 3 prints no DEM value at 1000 Hz, 1 g, 90 %: no paper DEM" in text
@@ -858,3 +858,35 @@ def test_pdf_shared_line_is_wrapped_to_the_page_and_keeps_the_whole_sha256(tmp_p
             # the PDF sets the advances and kerning matplotlib measures: 0.5 pt of slack
             assert 0.0 <= x and x + width <= _PDF_PAGE[0] * 72 + 0.5, (x, width, text)
             assert 0.0 <= y and y + size <= _PDF_PAGE[1] * 72, (y, text)
+
+
+def test_pdf_says_a_value_is_every_rows_only_where_every_row_states_it(tmp_path, provenance):
+    """A --pool report of tests of a specimen file (its sha256 296c22...) beside a test named
+    only steel_6mm (no sha256): the PDF showed the specimen column and said "specimen sha256
+    296c22..." of every row that states it, as if the name-only test's too. A value is now
+    under the title only where every row states it; the sha256 is a column wherever the
+    specimen is (they identify a specimen together), and so are DEM settings some rows lack."""
+    from test_report_case_sheet import _pdf_text
+
+    from pidcore.report.render import pdf_columns, pdf_shared_line, pdf_table_cells
+
+    sha = "296c220d8209d22bc0278b69f122274ac239d783c35f2bbe672b36d1cee67bcd"
+    table = _two_settings_table()
+    table["material"] = "steel"
+    table["specimen"] = ["сталь_6мм_鋼", "steel_6mm", "сталь_6мм_鋼"]
+    table["specimen sha256"] = [sha, "", sha]
+    table["DEM settings"] = ["cells 2", "", "cells 2"]
+    cols = pdf_columns(table)
+    assert {"specimen", "specimen sha256", "DEM settings"} <= set(cols)
+    assert pdf_shared_line(table) == "Every row: material steel; direction z"
+    labels, rows = pdf_table_cells(table)
+    sha_cells = [row[cols.index("specimen sha256")].replace("\n", "") for row in rows]
+    assert sha_cells == [sha, "", sha]  # whole, in its rows only
+    text = _pdf_text(write_report(table, {}, provenance, tmp_path / "r", "pdf")["pdf"]
+                     .read_bytes())
+    assert "Every row: material steel; direction z" in text and "sha256 296c" not in text
+    # one specimen throughout: its name and sha256 said once, under the title
+    table["specimen"] = "сталь_6мм_鋼"
+    table["specimen sha256"] = sha
+    assert "specimen" not in pdf_columns(table) and "specimen sha256" not in pdf_columns(table)
+    assert pdf_shared_line(table).endswith(f"specimen сталь_6мм_鋼; specimen sha256 {sha}")

@@ -49,7 +49,7 @@ from .table import (
     MEASURED_EQ11_STDERR_COLUMN,
     PACKING_RATIO_COLUMN,
     SPECIMEN_SHA256_COLUMN,
-    differing_columns,
+    shared_identity,
 )
 
 #: File written into every report folder; only folders holding it are ever replaced.
@@ -443,34 +443,35 @@ def _pdf_text_cell(text: str) -> str:
 
 def pdf_columns(table: pd.DataFrame) -> list[str]:
     """The columns of the PDF table: the :data:`PDF_COLUMNS` the table has, then those of
-    :data:`~pidcore.report.table.ROW_IDENTITY_COLUMNS` in which its rows differ
-    (:func:`~pidcore.report.table.differing_columns`; a value every row shares is said once
-    under the title, :func:`pdf_shared_line`), then ``note`` (its rows' numbers,
-    :func:`numbered_notes`). Two DEM runs of one load case at other settings read as two
-    identical rows of different SDCs: the PDF showed none of these columns."""
-    from .table import with_band_text
+    :data:`~pidcore.report.table.ROW_IDENTITY_COLUMNS` some row states that not every row
+    shares (:func:`~pidcore.report.table.shared_identity`; a value every row shares is said
+    once under the title, :func:`pdf_shared_line`), the specimen's sha256 wherever its name
+    is shown (a name and its file's hash identify a specimen together), then ``note`` (its
+    rows' numbers, :func:`numbered_notes`). Two DEM runs of one load case at other settings
+    read as two identical rows of different SDCs: the PDF showed none of these columns."""
+    from .table import ROW_IDENTITY_COLUMNS, with_band_text
 
     shown = list(with_band_text(table.iloc[:0]).columns)
-    cols = [c for c in PDF_COLUMNS if c in shown] + differing_columns(table)
+    shared = shared_identity(table)
+    identity = [c for c in ROW_IDENTITY_COLUMNS if c in table.columns and c not in shared
+                and any(isinstance(v, str) and v for v in table[c])]
+    if "specimen" in identity and SPECIMEN_SHA256_COLUMN in shared:
+        identity.append(SPECIMEN_SHA256_COLUMN)
+    cols = [c for c in PDF_COLUMNS if c in shown] + identity
     return cols + (["note"] if "note" in table.columns else [])
 
 
 def pdf_shared_line(table: pd.DataFrame) -> str:
-    """What every row of ``table`` that states it shares of the row identity columns the PDF
-    leaves out (e.g. "material acrylic; direction z; DEM settings cells 8, ..."); "" where
-    none. A constant column tells no row apart and costs A4 width beside the SDC columns, but
-    its value is still the reader's to know."""
-    from .table import ROW_IDENTITY_COLUMNS
-
-    parts = []
-    for column in ROW_IDENTITY_COLUMNS:
-        if column in table.columns and column not in differing_columns(table):
-            values = {v for v in table[column] if isinstance(v, str) and v}
-            if values:
-                # cut as in the table's cells: a specimen or material named at 4 KiB would
-                # take the page (a sha256's 64 digits are kept whole)
-                parts.append(f"{column} {bounded_stem(values.pop(), _PDF_CELL_MOST)}")
-    return f"Every row that states it: {'; '.join(parts)}" if parts else ""
+    """What every row of ``table`` shares of the row identity columns the PDF leaves out
+    (e.g. "material acrylic; direction z; DEM settings cells 8, ..."); "" where none. A
+    constant column tells no row apart and costs A4 width beside the SDC columns, but its
+    value is still the reader's to know."""
+    shown = pdf_columns(table)
+    # cut as in the table's cells: a specimen or material named at 4 KiB would take the page
+    # (a sha256's 64 digits are kept whole)
+    parts = [f"{column} {bounded_stem(value, _PDF_CELL_MOST)}"
+             for column, value in shared_identity(table).items() if column not in shown]
+    return f"Every row: {'; '.join(parts)}" if parts else ""
 
 
 def pdf_table_cells(table: pd.DataFrame) -> tuple[list[str], list[list[str]]]:

@@ -125,6 +125,20 @@ def differing_columns(table: pd.DataFrame) -> list[str]:
             if len(values) > 1:
                 out.append(column)
     return out
+
+
+def shared_identity(table: pd.DataFrame) -> dict[str, str]:
+    """Those :data:`ROW_IDENTITY_COLUMNS` of ``table`` whose every row states one value, by
+    that value. An empty cell is not that value: a test of ``steel_6mm`` named only (no
+    sha256) beside tests of a file's specimen does not share that file's sha256, nor a row
+    of no DEM runs the others' DEM settings."""
+    out = {}
+    for column in ROW_IDENTITY_COLUMNS:
+        if column in table.columns and len(table):
+            values = {v if isinstance(v, str) else "" for v in table[column]}
+            if len(values) == 1 and "" not in values:
+                out[column] = values.pop()
+    return out
 #: Columns an analyses table needs (as :meth:`pidcore.store.Store.list_analyses` gives, with the
 #: load case fields the report pipeline stores in each record).
 ANALYSIS_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_percent", "sdc",
