@@ -797,7 +797,7 @@ def test_latex_writes_a_name_past_latin1_so_that_pdflatex_reads_it(tmp_path, pro
     assert re.search(r"\\iftutex\s+\\usepackage\{fontspec\}\s+\\newcommand\{\\pidcorechar\}"
                      r"\[2\]\{#2\}\s+\\else\s+\\usepackage\[utf8\]\{inputenc\}\s+"
                      r"\\usepackage\[T1\]\{fontenc\}\s+\\newcommand\{\\pidcorechar\}\[2\]"
-                     r"\{\\texttt\{\[U\+#1\]\}\}\s+\\fi", preamble)
+                     r"\{\\texttt\{\[U\+#1\]\}\\allowbreak\{\}\}\s+\\fi", preamble)
 
 
 def _pdf_placed_text(data: bytes) -> list[tuple[float, float, float, str]]:
@@ -890,3 +890,42 @@ def test_pdf_says_a_value_is_every_rows_only_where_every_row_states_it(tmp_path,
     table["specimen sha256"] = sha
     assert "specimen" not in pdf_columns(table) and "specimen sha256" not in pdf_columns(table)
     assert pdf_shared_line(table).endswith(f"specimen сталь_6мм_鋼; specimen sha256 {sha}")
+
+
+def test_latex_columns_hold_what_pdflatex_prints_of_a_name_past_latin1(tmp_path, provenance):
+    """pdflatex prints a character past Latin-1 as its code point, [U+0441]: the column of
+    "сталь_6мм_鋼" was sized for 12 characters (1.28 cm) where pdflatex prints 66 in pieces
+    no line could break, overprinting the sha256 beside it (20 overfull boxes). Each piece
+    pdflatex cannot break, as the .tex's preamble defines \\pidcorechar for it, now fits its
+    column (TeX not needed: the widths and breaks are read from the .tex)."""
+    from pidcore.report.render import _TEX_CHAR
+
+    table = _two_settings_table()
+    table["material"] = "сталь"
+    table["specimen"] = ["сталь_6мм_鋼", "x鋼", "сталь_6мм_鋼"]
+    table["specimen sha256"] = "296c220d8209d22bc0278b69f122274ac239d783c35f2bbe672b36d1cee67bcd"
+    text = write_report(table, {}, provenance, tmp_path / "r", "tex")["tex"].read_text(
+        encoding="utf-8")
+    pdflatex = re.search(r"\\else\s.*?\\newcommand\{\\pidcorechar\}\[2\]\{(.*)\}\s*\\fi",
+                         text, re.S).group(1)
+    tables = re.findall(r"\\begin\{longtable\}\{(.*?)\}$(.*?)\\end\{longtable\}", text,
+                        re.M | re.S)
+    assert any("& specimen &" in body for _, body in tables)
+    checked = 0
+    for spec, body in tables:
+        widths = [float(w) for w in re.findall(r"p\{([0-9.]+)cm\}", spec)]
+        for line in body.split(r"\endhead")[1].splitlines():
+            if not line.endswith(r"\\") or line.startswith("\\"):
+                continue
+            cells = line[:-2].split(" & ")
+            assert len(cells) == len(widths)
+            for cell, width in zip(cells, widths, strict=True):
+                shown = re.sub(r"\\pidcorechar\{([0-9A-F]+)\}\{.\}",
+                               lambda m: pdflatex.replace("#1", m.group(1)), cell)
+                for piece in re.split(r"\\allowbreak\{\}|\s+", shown):
+                    printed = re.sub(r"\\texttt|[{}]", "", piece).replace("\\_", "_")
+                    # _TEX_CHAR is the widest letter of 7 pt; the widths have 2 decimals
+                    assert len(printed) * _TEX_CHAR <= width + 0.005, (printed, width)
+                    checked += "[U+" in printed
+    # each code point a piece of its own: 8 of each long name, 1 of "x鋼", 5 of each material
+    assert checked == 8 + 1 + 8 + 3 * 5

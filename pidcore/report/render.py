@@ -253,7 +253,8 @@ _TEX_PREAMBLE = (
     r"\else",
     r"  \usepackage[utf8]{inputenc}",
     r"  \usepackage[T1]{fontenc}",
-    rf"  \newcommand{{\{_TEX_CHAR_COMMAND}}}[2]{{\texttt{{[U+#1]}}}}",
+    # a line may break after each: a name of 12 such characters is 90 unbroken under pdflatex
+    rf"  \newcommand{{\{_TEX_CHAR_COMMAND}}}[2]{{\texttt{{[U+#1]}}\allowbreak{{}}}}",
     r"\fi",
 )
 
@@ -277,6 +278,15 @@ def tex_escape(text: str) -> str:
     return "".join(out)
 
 
+def tex_printed_length(text: str) -> int:
+    r"""Characters pdflatex prints of :func:`tex_escape`'s ``text``: a ``\pidcorechar``'s
+    code point, ``[U+0441]``, counts its 8, a symbol of :data:`_TEX_SYMBOLS` 2 (a dash, ≤ or
+    Ω is up to two digits wide). A column sized for "сталь_6мм_鋼"'s 12 characters was 1.3 cm
+    for its 66, which ran 4 cm into the next column."""
+    return sum(len(f"[U+{ord(ch):04X}]") if ord(ch) > 0xFF and ch not in _TEX_SYMBOLS
+               else 2 if ch in _TEX_SYMBOLS else 1 for ch in text)
+
+
 #: Columns of long text (a note of 230-390 characters, the source files, a sha256), set out of
 #: the LaTeX table's numbers: in one line of the tabular they made rows ~1200 characters wide,
 #: scaled to 0.12 (1.2 pt text). The LaTeX writes them in a table of their own, by row number,
@@ -293,18 +303,23 @@ _TEX_PAD = 2 * 3 / 72.27 * 2.54
 
 
 def _tex_breakable(text: str, most: int) -> str:
-    """``text`` escaped, a line break allowed in a word of more than ``most`` characters (a
-    file name or a sha256 has no space to break at in a narrow column) after each of its
-    ``_ / . , -`` and every ``most`` characters."""
+    """``text`` escaped, a line break allowed in a word of more than ``most`` characters as
+    pdflatex prints them (:func:`tex_printed_length`; a file name or a sha256 has no space to
+    break at in a narrow column) after each of its ``_ / . , -`` and every ``most``
+    characters."""
     words = []
     for word in re.split(r"(\s+)", text):
-        if len(word) <= most:
+        if tex_printed_length(word) <= most:
             words.append(tex_escape(word))
             continue
         out, run = [], 0
         for ch in word:
+            printed = tex_printed_length(ch)
+            if run and run + printed > most:  # a code point's 8 would end past the column
+                out.append(r"\allowbreak{}")
+                run = 0
             out.append(tex_escape(ch))
-            run += 1
+            run += printed
             if ch in "_/.,-" or run >= most:
                 out.append(r"\allowbreak{}")
                 run = 0
@@ -353,7 +368,7 @@ def _tex_width(columns: Sequence[str], texts: Sequence[Sequence[str]]) -> list[f
     for i, column in enumerate(columns):
         words = column.replace("/", "/ ").split()
         # at least 5: the capitals of "DEM" are as wide as 5 digits
-        chars = max([len(row[i]) for row in texts] + [max(map(len, words)), 5])
+        chars = max([tex_printed_length(row[i]) for row in texts] + [max(map(len, words)), 5])
         out.append(chars * _TEX_CHAR)
     return out
 
@@ -385,10 +400,14 @@ def _write_tex(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenanc
     # the text by row: the columns share the width left by the row and note numbers, each
     # as much as its longest cell asks (up to 60 characters) of it
     texts = display_rows(table, text_columns)
-    asked = [max([min(len(row[i]), 60) for row in texts] + [len(c) // 2, 6])
+    asked = [max([min(tex_printed_length(row[i]), 60) for row in texts] + [len(c) // 2, 6])
              for i, c in enumerate(text_columns)]
     room = _TEX_TEXT_WIDTH - 2 * (row_width[0] + _TEX_PAD) - _TEX_PAD * len(text_columns)
-    widths = [room * a / sum(asked) for a in asked]
+    # a code point, [U+0441], cannot break: each column at least as wide as its widest
+    least = [max((tex_printed_length(ch) for row in texts for ch in row[i] if ord(ch) > 0xFF),
+                 default=0) * _TEX_CHAR for i in range(len(text_columns))]
+    widths = [b + (room - sum(least)) * a / sum(asked) for a, b in zip(asked, least,
+                                                                         strict=True)]
     rows = [[n, *(_tex_breakable(v, int(w / _TEX_CHAR)) for v, w in zip(row, widths,
                                                                          strict=True)), mark]
             for n, row, mark in zip(ids, texts, marks, strict=True)]
