@@ -248,6 +248,10 @@ def test_grid_that_cannot_be_modelled_is_labelled_no_model_and_says_why():
     out = Aligner.from_tables(one_fill).align(LoadCase(75.0, 3.0, 50.0))
     assert out.status == "no_model" and "no_model" in ALIGNMENT_STATUSES
     assert "no pchip model" in out.message and "fill_percent" in out.message
+    # the runs named once: "no pchip model over our DEM runs (acrylic, z): our DEM runs
+    # (acrylic, z): column fill_percent ..." said it twice
+    assert out.message.count("our DEM runs (acrylic, z)") == 1
+    assert "no pchip model over our DEM runs (acrylic, z): column fill_percent" in out.message
     assert math.isnan(out.sdc_dem)
 
 

@@ -947,7 +947,11 @@ def build_dem_models(cases: list[DemCase]) -> dict[tuple[str, str], object]:
             # what is left out
             models[kind] = complete_grid_model(table, value="sdc", source=source)[0]
         except ParameterError as exc:
-            models[kind] = f"no pchip model over our DEM runs ({kind[0]}, {kind[1]}): {exc}"
+            # the refusal names its source first: "no pchip model over our DEM runs (steel,
+            # z): our DEM runs (steel, z): ..." said it twice
+            why = str(exc)
+            models[kind] = f"no pchip model over {why}" if why.startswith(f"{source}: ") \
+                else f"no pchip model over {source}: {why}"
     return models
 
 
