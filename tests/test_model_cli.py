@@ -893,3 +893,26 @@ def test_the_out_folder_holds_one_runs_outputs_alone_and_foreign_files_are_refus
     assert main(["model", "figures", "--out", str(tmp_path / "d")]) == 2
     assert "holds 'equivalent_damper.json', which pidcore model figures does not write" \
         in capsys.readouterr().err
+
+
+def test_figures_say_once_which_characters_they_could_not_draw(tmp_path, monkeypatch, capsys):
+    """DEM runs of a specimen named сталь_6мм_鋼: every figure's title printed matplotlib's
+    "Glyph 37628 missing from font(s) DejaVu Sans" UserWarning, with its source line, on the
+    terminal; one note names the character instead."""
+    import warnings
+
+    from pidcore.report.fonts import installed_fallback_families
+
+    mine = _specimen_runs("сталь_6мм_鋼", "a" * 64, coupon_kg=0.05, fixture_kg=0.12,
+                          sdc_scale=0.5)
+    _fake_store(monkeypatch, lambda: mine)
+    with warnings.catch_warnings(record=True) as shown:
+        warnings.simplefilter("always")
+        assert _run(["model", "figures", "--out", str(tmp_path / "f"), "--table", "store",
+                     "--store", str(tmp_path / "s.h5")]) == 0
+    assert not [w for w in shown if "Glyph" in str(w.message)]
+    err = capsys.readouterr().err
+    if not installed_fallback_families():  # none where these tests run (fc-list :lang=zh)
+        assert err.count("could not be drawn") == 1
+        assert "pidcore model figures: note: 1 character(s) could not be drawn in the " \
+               "figures (鋼)" in err

@@ -929,3 +929,35 @@ def test_latex_columns_hold_what_pdflatex_prints_of_a_name_past_latin1(tmp_path,
                     checked += "[U+" in printed
     # each code point a piece of its own: 8 of each long name, 1 of "x鋼", 5 of each material
     assert checked == 8 + 1 + 8 + 3 * 5
+
+
+def test_report_says_once_which_characters_its_figures_could_not_draw(tmp_path, provenance,
+                                                                     monkeypatch, capsys):
+    """A report of a specimen named сталь_6мм_鋼 printed matplotlib's "Glyph 37628 missing
+    from font(s) DejaVu Sans" UserWarning, with its source line, for each drawing of the
+    name (the PDF table, its notes, the figures): a note says it once instead."""
+    import warnings
+
+    import pidcore.report.pipeline as pipeline
+    from pidcore.cli import main
+    from pidcore.report.fonts import installed_fallback_families
+
+    table = _two_settings_table()
+    table["specimen"] = ["сталь_6мм_鋼", "steel_6mm", "сталь_6мм_鋼"]
+
+    def make_report(files, *, out_dir, **kwargs):
+        fig = Figure(figsize=(3, 2))  # made within the command, as the report's figures
+        fig.suptitle("DEM runs of сталь_6мм_鋼")
+        return pipeline.ReportResult(write_report(table, {"f": fig}, provenance, out_dir,
+                                                  "pdf"), table)
+
+    monkeypatch.setattr(pipeline, "make_report", make_report)
+    with warnings.catch_warnings(record=True) as shown:
+        warnings.simplefilter("always")
+        assert main(["report", "--store", str(tmp_path / "s.h5"), "--out",
+                     str(tmp_path / "rp")]) == 0
+    assert not [w for w in shown if "Glyph" in str(w.message)]
+    out = capsys.readouterr().out
+    if not installed_fallback_families():  # none where these tests run (fc-list :lang=zh)
+        assert out.count("could not be drawn") == 1
+        assert "note: 1 character(s) could not be drawn in the figures and PDF pages (鋼)" in out

@@ -491,6 +491,7 @@ def _direction_text(runs) -> str:
 
 def run_figures(args: argparse.Namespace) -> int:
     from ..report.figures import plot_sdc_vs_acceleration, plot_sdc_vs_frequency, save_figure
+    from ..report.fonts import figure_fonts, missing_glyphs_note
 
     check_out_folder(args.out)
     # the figures of fills an earlier model had stayed beside this one's
@@ -517,7 +518,10 @@ def run_figures(args: argparse.Namespace) -> int:
             paths += save_figure(fig, folder, f"sdc_vs_frequency_{acc:g}g")
         return paths
 
-    paths = write_folder_whole(args.out, _figure_file, "model figures", draw)
+    with figure_fonts() as missing:  # a specimen's or store's name in CJK in the titles
+        paths = write_folder_whole(args.out, _figure_file, "model figures", draw)
     for path in paths:
         print(path)
+    if missing:
+        print(f"pidcore model figures: note: {missing_glyphs_note(missing)}", file=sys.stderr)
     return 0

@@ -10,6 +10,7 @@ import sys
 
 from .. import interrupt
 from ..interrupt import untouched
+from ..report.fonts import figure_fonts, missing_glyphs_note
 from ..report.render import (
     display_rows,
     folder_identity,
@@ -124,18 +125,20 @@ def run(args: argparse.Namespace) -> int:
     # Ctrl-C whether the analyses of FILES were saved
     store_before = folder_identity(args.store) if args.store is not None else None
     try:
-        result = make_report(
-            args.files, out_dir=args.out, store=args.store, dem_store=args.dem_store,
-            formats=args.format, fill_percent=args.fill, material=args.material,
-            direction=args.direction, sidecar=args.sidecar, options=analysis_options(args),
-            options_given=given_options(args),
-            specimen=specimen, pool=args.pool, calibration=args.calibration,
-            calibration_key=args.calibration_key,
-            accept_implausible=args.accept_implausible, progress=progress_wanted(args),
-            wording=lambda text: cli_words(text, "report"), key=args.key,
-            case_sheets=args.case_sheets)
+        with figure_fonts() as missing:
+            result = make_report(
+                args.files, out_dir=args.out, store=args.store, dem_store=args.dem_store,
+                formats=args.format, fill_percent=args.fill, material=args.material,
+                direction=args.direction, sidecar=args.sidecar, options=analysis_options(args),
+                options_given=given_options(args),
+                specimen=specimen, pool=args.pool, calibration=args.calibration,
+                calibration_key=args.calibration_key,
+                accept_implausible=args.accept_implausible, progress=progress_wanted(args),
+                wording=lambda text: cli_words(text, "report"), key=args.key,
+                case_sheets=args.case_sheets)
         print(short_table(result.table))
-        for note in result.notes:  # in the command's words (wording=)
+        glyphs = missing_glyphs_note(missing, "the figures and PDF pages")
+        for note in [*result.notes, *([glyphs] if glyphs else [])]:  # in the command's words
             print(f"note: {note}")
         for name, path in result.paths.items():
             print(f"wrote {name}: {path}")
