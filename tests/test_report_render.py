@@ -688,6 +688,23 @@ def test_pdf_table_tells_rows_of_one_load_case_apart_and_numbers_their_notes(tmp
     assert "1. the paper's Table 3 prints no DEM value at 1000 Hz, 1 g, 90 %: no paper DEM" in text
 
 
+def test_pdf_writes_a_name_that_reads_as_mathtext_as_its_text(tmp_path, provenance):
+    """A specimen or material named like TeX math ("$\\x$", "$^$") failed the whole PDF in
+    matplotlib's mathtext parser (table cells, notes and provenance are parsed as math by
+    default): they are written as the characters they are."""
+    from test_report_case_sheet import _pdf_text
+
+    table = _two_settings_table()
+    table["material"] = ["a$\\x$b", "c$^$d", "acrylic"]  # differing: a column of the PDF
+    table.loc[2, "note"] = "a note naming $\\frac{$ as typed"
+    text = _pdf_text(write_report(table, {}, provenance, tmp_path / "r", "pdf")["pdf"]
+                     .read_bytes())
+    # the extraction splits a string at a kerning step and keeps the PDF's "\\" escape: the
+    # parts on either side of the backslash are what can be asserted
+    assert "c$^$d" in text and "a$" in text and "x$b" in text
+    assert "frac{$ as typed" in text
+
+
 def test_numbered_notes_give_one_note_one_number_in_the_order_rows_first_name_it():
     from pidcore.report.render import numbered_notes
 

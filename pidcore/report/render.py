@@ -658,6 +658,8 @@ def _write_pdf(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenanc
                 _pdf_row_height(max(c.count("\n") + 1 for c in row)) for row in chunk]
             for (row, _), cell in tab.get_celld().items():
                 cell.set_height(heights[row] / inches)
+                # a name's "$\x$" is text: mathtext failed the whole PDF on it
+                cell.get_text().set_parse_math(False)
             listed = list(dict.fromkeys(int(marks[i]) for i in page if marks[i]))
             if listed:
                 # under the table as drawn: its height follows its rows' lines
@@ -667,7 +669,7 @@ def _write_pdf(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenanc
                 text = [line for k in sorted(listed) for line in _note_lines(k, notes[k - 1])]
                 ax.text(0.0, bottom - 0.02, "Notes (the number in a row's note column):\n"
                         + "\n".join(text), transform=ax.transAxes, va="top", ha="left",
-                        fontsize=6)
+                        fontsize=6, parse_math=False)
             pdf.savefig(fig)
             plt.close(fig)
         for fig in (figure_objects or {}).values():
@@ -678,7 +680,7 @@ def _write_pdf(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenanc
         lines = [part for line in prov.lines()
                  for part in textwrap.wrap(line, 150, subsequent_indent="    ") or [""]]
         fig.text(0.03, 0.97, "Provenance\n\n" + "\n".join(lines), va="top",
-                 family="monospace", fontsize=6)
+                 family="monospace", fontsize=6, parse_math=False)
         pdf.savefig(fig)
         plt.close(fig)
     return path
