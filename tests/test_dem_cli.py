@@ -286,6 +286,43 @@ def test_sweep_states_each_cases_sdc_energy_balance_and_steady_state_as_dem_run_
     assert all(isinstance(c["energy_balance_error"], float) for c in doc["cases"])
 
 
+def test_sweep_says_each_runs_notes_as_dem_run_does_reused_runs_included(tmp_path, capsys):
+    """`dem sweep --cycles 10` stored 20 steady cycles (whole blocks of 10, the two that
+    detect the steady state both measured) where `dem run` of the same case says "steady
+    window rounded up"; the sweep said only "steady state detected" and its --json had
+    `"notes": []`, though --cycles promises "(noted)". Each case must carry the notes `dem
+    run` gives of its run, simulated now or reused."""
+    store = tmp_path / "s.h5"
+    # --cycles 2 in blocks of 10: the window is rounded up in every run (the note's
+    # trigger), one cell: no standard error (a second note, said why)
+    stored = ["--store", str(store), "--cells", "1", "--cycles", "2", "--no-progress"]
+    assert main(["dem", "run", "--frequency", "500", "--acceleration", "5", "--fill", "50",
+                 *stored, "--json"]) == 0
+    run_notes = json.loads(capsys.readouterr().out)["notes"]
+    assert [n for n in run_notes if n.startswith("steady window rounded up: ")
+            and "cycles measured for the 2 asked" in n], run_notes
+    sweep = ["dem", "sweep", "--frequencies", "500,1000", "--accelerations", "5", "--fills",
+             "50", "--workers", "1", *stored]
+    assert main([*sweep, "--json"]) == 0  # 500 Hz reused, 1000 Hz simulated now
+    reused, simulated = json.loads(capsys.readouterr().out)["cases"]
+    assert (reused["status"], simulated["status"]) == ("already stored", "simulated")
+    assert reused["notes"] == run_notes  # the stored run's notes, in dem run's words
+    assert main(["dem", "run", "--frequency", "1000", "--acceleration", "5", "--fill", "50",
+                 *stored, "--json"]) == 0  # the run the sweep simulated, reused
+    assert simulated["notes"] == json.loads(capsys.readouterr().out)["notes"]
+    assert any(n.startswith("steady window rounded up: ") for n in simulated["notes"])
+    # the text output says each note once, naming the cases it is of
+    assert main(sweep) == 0
+    said = [line for line in capsys.readouterr().out.splitlines() if line.startswith("note (")]
+    for case in (reused, simulated):
+        where = f"{case['frequency_hz']:g} Hz, 5 g, fill 50 %"
+        for note in case["notes"]:
+            (line,) = [line for line in said if line.endswith(f"): {note}")]
+            assert line.startswith(("note (every case): ", f"note ({where}")) or \
+                f"; {where})" in line, line
+    assert len(said) == len(set(reused["notes"]) | set(simulated["notes"]))
+
+
 def test_sweep_runs_the_values_given_in_place_of_the_grids(tmp_path, capsys):
     from pidcore.loadcase import parse_key
     from pidcore.store import Store

@@ -307,8 +307,8 @@ def _sweep_specimens(cases: list[dict]) -> str:
 
 def _print_sweep(args: argparse.Namespace, summary) -> None:
     """What a finished sweep did: its JSON document, or each case's results (as ``dem run``
-    states them) and how its run was got, the counts, and the cases it found to be the same
-    simulation as another."""
+    states them) and how its run was got, the counts, the cases it found to be the same
+    simulation as another, and its runs' notes."""
     if args.json:
         print(json.dumps(summary.to_dict()))
     else:
@@ -330,6 +330,26 @@ def _print_sweep(args: argparse.Namespace, summary) -> None:
                       f"{case['acceleration_g']:g} g): {case['status']} ("
                       f"{case.get('particles_per_cell', '?')} particles per cell, the same "
                       f"seed and settings), not simulated again: {case['store_key']}")
+        for line in _sweep_notes(summary.cases):
+            print(line)
+
+
+def _where(case: dict) -> str:
+    """``"500 Hz, 5 g, fill 50 %"``: a sweep's case by its load case, as asked."""
+    return (f"{case['frequency_hz']:g} Hz, {case['acceleration_g']:g} g, fill "
+            f"{case['fill_percent']:g} %")
+
+
+def _sweep_notes(cases: list[dict]) -> list[str]:
+    """The notes ``dem run`` prints of each case's stored run, each once, naming the cases it
+    is of (``every case`` where all of them): a note of the specimen or of the settings is
+    the same for every case, and a line of it per case would bury the others."""
+    of: dict[str, list[str]] = {}
+    for case in cases:
+        for note in case.get("notes", ()):
+            of.setdefault(note, []).append(_where(case))
+    return [f"note ({'every case' if len(where) == len(cases) > 1 else '; '.join(where)}): "
+            f"{note}" for note, where in of.items()]
 
 
 def _sweep_case_line(case: dict) -> str:
@@ -338,8 +358,7 @@ def _sweep_case_line(case: dict) -> str:
     whether its run was simulated now or reused."""
     how = ("simulated now" if case["status"] == "simulated" else
            f"reused: {case['status']}")
-    where = (f"{case['frequency_hz']:g} Hz, {case['acceleration_g']:g} g, fill "
-             f"{case['fill_percent']:g} %: ")
+    where = f"{_where(case)}: "
     if case.get("sdc") is None:  # not stored (a run stored without an SDC reads so too)
         return f"{where}no stored result ({how})"
     stderr, balance = case.get("sdc_stderr"), case.get("energy_balance_error")

@@ -29,6 +29,7 @@ from ..records import json_safe
 from ..specimen import Specimen, fill_override_note, is_paper_coupon
 from .persist import (
     dem_run_entry,
+    load_dem_result,
     other_files_runs_note,
     own_run_keys,
     run_identity,
@@ -368,7 +369,8 @@ class SweepSummary:
     ``fill_percent`` (as asked), ``material``, ``direction``, ``store_key``, ``status`` (one of
     :data:`SWEEP_CASE_STATUSES`) and, once the run is stored, ``stored_fill_percent`` (the
     fill its run is stored with: another where the same simulation was found under another
-    fill) and :data:`SWEEP_CASE_FIELDS`.
+    fill), :data:`SWEEP_CASE_FIELDS` and ``notes``, the stored run's
+    :attr:`~pidcore.dem.result.DemResult.notes` (those ``pidcore dem run`` prints of it).
     """
 
     completed: list[str] = field(default_factory=list)
@@ -403,15 +405,22 @@ class SweepSummary:
         if runs.empty:
             return
         by_key = runs.set_index("case_key")
+        notes: dict[str, list[str]] = {}  # by key: two cases of one simulation read it once
         for case in self.cases:
-            if case["store_key"] not in by_key.index:
+            key = case["store_key"]
+            if key not in by_key.index:
                 continue  # not finished (interrupted)
-            row = by_key.loc[case["store_key"]]
+            row = by_key.loc[key]
             case["stored_fill_percent"] = float(row["fill_percent"])
             for name in SWEEP_CASE_FIELDS:
                 case[name] = json_safe(row.get(name))
             if case.get("steady_detected") is not None:  # the store reads a bool back as 0/1
                 case["steady_detected"] = bool(case["steady_detected"])
+            # derived from the whole run, not stored: a steady window rounded up past
+            # --cycles was said by `dem run` of the same run and by no sweep
+            if key not in notes:
+                notes[key] = list(load_dem_result(store.get_dem_run(key)).notes)
+            case["notes"] = list(notes[key])
 
 
 def run_sweep(cases: Sequence[LoadCase], config: DemConfig, *,
