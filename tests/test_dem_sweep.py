@@ -347,7 +347,8 @@ def test_a_scheduler_lost_mid_sweep_is_one_error_naming_it_and_the_runs_stored_a
     logging.getLogger("distributed").addHandler(catch)
     try:
         with pytest.raises(SimulationError, match=f"^scheduler {address}: the connection to "
-                                                  "the dask.distributed scheduler was lost"):
+                                                  "the dask.distributed scheduler was lost.*"
+                                                  "; the cases finished before are kept$"):
             run_sweep(CASES, CONFIG, store_path=store, scheduler=address, progress=False,
                       on_case=lose_the_scheduler)
     finally:
@@ -363,6 +364,58 @@ def test_a_scheduler_lost_mid_sweep_is_one_error_naming_it_and_the_runs_stored_a
     assert [record.getMessage() for record in logged] == []
 
 
+#: Set once a case has started on a dask worker (:func:`_every_case_held`).
+_STARTED = threading.Event()
+
+
+def _every_case_held(case, config, specimen=None):
+    """:func:`~pidcore.dem.sweep.run_case` once :data:`_HELD` is set: no case can finish
+    before the scheduler is gone."""
+    _STARTED.set()
+    _HELD.wait(60)
+    return run_case(case, config, specimen)
+
+
+@pytest.mark.timeout(120)  # dask's client tries to reconnect for 30 s: fail, not wait
+def test_a_scheduler_lost_before_any_case_finished_says_none_is_kept(tmp_path, monkeypatch):
+    """The scheduler lost before any case finished said "the cases finished before are kept"
+    though none had finished and nothing was stored."""
+    import contextlib
+
+    import pidcore.dem.sweep as sweep_module
+    from pidcore.errors import SimulationError
+
+    distributed = pytest.importorskip("distributed")
+    _HELD.clear()
+    _STARTED.clear()
+    monkeypatch.setattr(sweep_module, "run_case", _every_case_held)
+    store = tmp_path / "s.h5"
+    seen: list[str] = []
+    cluster = distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                       protocol="tcp", dashboard_address=None)
+    address = cluster.scheduler_address
+
+    def lose_the_scheduler() -> None:
+        # once a case runs (the sweep is under way), as a killed scheduler drops it
+        if _STARTED.wait(60):
+            cluster.sync(cluster.scheduler.close)
+
+    losing = threading.Thread(target=lose_the_scheduler, daemon=True)
+    losing.start()
+    try:
+        with pytest.raises(SimulationError, match=f"^scheduler {address}: the connection to "
+                                                  "the dask.distributed scheduler was lost.*"
+                                                  "; no case had finished, so none is kept$"):
+            run_sweep(CASES, CONFIG, store_path=store, scheduler=address, progress=False,
+                      on_case=lambda outcome: seen.append(outcome.key))
+    finally:
+        _HELD.set()
+        losing.join(60)
+        with contextlib.suppress(Exception):
+            cluster.close(timeout=2)
+    assert seen == [] and not Store(store).list_dem_runs().shape[0]
+
+
 def test_a_killed_pool_worker_is_one_error_not_a_traceback():
     """A DEM worker killed from outside (OOM killer, kill -9) ended `pidcore dem sweep` and
     `calibrate` with concurrent.futures' BrokenProcessPool traceback, exit 1."""
@@ -373,7 +426,9 @@ def test_a_killed_pool_worker_is_one_error_not_a_traceback():
 
     finished: list = []
     # os._exit ends the worker process at once, as SIGKILL would (picklable by reference)
-    with pytest.raises(SimulationError, match="worker process ended abruptly"):
+    # none finished: said so, not "the cases finished before it are kept"
+    with pytest.raises(SimulationError, match="worker process ended abruptly .*; no case had "
+                                              "finished, so none is kept$"):
         run_pooled(os._exit, [(9,), (9,)], workers=2, finish=finished.append)
     assert finished == []
 

@@ -280,6 +280,7 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
     pool = ProcessPoolExecutor(max_workers=min(workers, len(calls)),
                                mp_context=dem_process_context(),
                                initializer=init_dem_worker, initargs=(os.getpid(),))
+    finished = 0
     try:
         # submit() starts the workers: a Ctrl-C inside Process.start() could leave a worker
         # forked but not yet in the pool's table, out of reach of _stop_pool; held back until
@@ -289,17 +290,25 @@ def run_pooled(function: Callable, calls: Sequence[tuple], *, workers: int,
         interrupt.raise_if_interrupted()
         for future in _finished(futures, stop):
             finish(future.result())
+            finished += 1
     except BrokenProcessPool:
         # a worker killed from outside (the kernel's OOM killer, kill -9): a traceback of
         # concurrent.futures and exit 1 said neither what happened nor what was kept
         _stop_pool(pool)
         raise SimulationError(
             "a DEM worker process ended abruptly (killed, or out of memory?) while running "
-            "a case; the cases finished before it are kept") from None
+            f"a case; {_kept(finished)}") from None
     except BaseException:
         _stop_pool(pool)
         raise
     pool.shutdown()
+
+
+def _kept(finished: int) -> str:
+    """What a sweep ended by a lost worker or scheduler keeps, ``finished`` cases having been
+    handed on before: "the cases finished before are kept" said so where none had."""
+    return ("the cases finished before are kept" if finished else
+            "no case had finished, so none is kept")
 
 
 #: What a stop says (:func:`pidcore.interrupt.raise_if_stopped`).
@@ -708,9 +717,11 @@ def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler
         futures = [client.submit(run_case, case, config, specimen, key=f"pidcore-{key}",
                                  pure=False)
                    for case, key in todo]
+        finished = 0
         try:
             for future in as_completed(futures):
                 finish(future.result())
+                finished += 1
         except (FutureCancelledError, CommClosedError) as exc:
             if not _connection_lost(client, exc):
                 client.cancel(futures)
@@ -722,7 +733,7 @@ def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler
             raise SimulationError(
                 f"scheduler {scheduler}: the connection to the dask.distributed scheduler "
                 "was lost while the sweep ran (the scheduler stopped, or the network "
-                "failed?); the cases finished before are kept") from None
+                f"failed?); {_kept(finished)}") from None
         except BaseException:
             client.cancel(futures)
             raise
