@@ -606,7 +606,12 @@ def assumed(stated: StatedLoadCase | None, specimen: str,
     :attr:`FileSettings.specimen`); ``specimen_given``: ``specimen=FILE``, whose particles a
     file of another named specimen (a sidecar's ``coupon_B``) takes where nothing states its
     own (``"material_from"``: the name of ``specimen_given``). A file without a stated fill has no
-    load case, hence no material: only its specimen is assumed.
+    load case, hence no material: only its specimen is assumed. A file that is the paper's
+    coupon's although ``specimen_given`` was given is so because its particles are others
+    than that specimen's (:func:`resolve_settings` names only a file of its particles): the
+    note said "no specimen named ... name another with specimen=FILE" beside the one named,
+    so ``"specimen_given"`` and ``"specimen_given_material"`` say which it was and its
+    particles, ``"file_material"`` the file's (where it states a load case).
     """
     from .specimen import PAPER_SPECIMEN_NAME
 
@@ -623,6 +628,12 @@ def assumed(stated: StatedLoadCase | None, specimen: str,
             found["material_from"] = specimen_given.name
     if not specimen:
         found[SPECIMEN_COLUMN] = PAPER_SPECIMEN_NAME
+        if specimen_given is not None and (
+                stated is None or stated.material != specimen_given.particles.material):
+            found["specimen_given"] = specimen_given.name
+            found["specimen_given_material"] = specimen_given.particles.material
+            if stated is not None:
+                found["file_material"] = stated.material
     return found
 
 
@@ -643,12 +654,27 @@ def assumption_notes(name: str, assumptions: Mapping[str, str], *, files: int = 
         notes.append(f"{name}: particle material not stated, {assumptions['material']} assumed "
                      "(the paper's coupon's particles); if they are others, state them with "
                      "material=NAME, a sidecar's material column or specimen=FILE")
-    if SPECIMEN_COLUMN in assumptions:
+    if "specimen_given" in assumptions:
+        given, particles = assumptions["specimen_given"], assumptions["specimen_given_material"]
+        mine = assumptions.get("file_material")
+        files_ = "the file's" if files == 1 else "the files'"
+        notes.append(f"{name}: specimen {given!r} (specimen=) is of other particles "
+                     f"({particles}) than {files_}" + (f" ({mine})" if mine else "")
+                     + f", so the paper's coupon ({assumptions[SPECIMEN_COLUMN]})"
+                     + (f" with {mine} particles" if mine else "") + " is assumed: reports "
+                     f"and calibrations compare {it} with that coupon's DEM runs; name a "
+                     f"specimen of {mine or its} particles with specimen=FILE or a sidecar's "
+                     "specimen column")
+    elif SPECIMEN_COLUMN in assumptions:
         notes.append(f"{name}: no specimen named, the paper's coupon "
                      f"({assumptions[SPECIMEN_COLUMN]}) assumed: reports and calibrations "
                      f"compare {it} with that coupon's DEM runs; name another with "
                      "specimen=FILE or a sidecar's specimen column")
     return notes
+
+
+#: What :func:`assumed` says of a ``specimen_given`` that a file is not of.
+_SPECIMEN_GIVEN_KEYS = ("specimen_given", "specimen_given_material", "file_material")
 
 
 def _listed(names: Sequence[str]) -> str:
@@ -667,14 +693,16 @@ def files_assumption_notes(found: Sequence[tuple[str, Mapping[str, str]]]) -> li
             grouped.setdefault(("material", assumptions["material"],
                                 assumptions.get("material_from", "")), []).append(name)
         if SPECIMEN_COLUMN in assumptions:
-            grouped.setdefault((SPECIMEN_COLUMN, assumptions[SPECIMEN_COLUMN]),
+            grouped.setdefault((SPECIMEN_COLUMN, assumptions[SPECIMEN_COLUMN],
+                                *(assumptions.get(k, "") for k in _SPECIMEN_GIVEN_KEYS)),
                                []).append(name)
     notes = []
     for key, names in grouped.items():
         if key[0] == "material":
             one = {"material": key[1], **({"material_from": key[2]} if key[2] else {})}
         else:
-            one = {SPECIMEN_COLUMN: key[1]}
+            one = {SPECIMEN_COLUMN: key[1],
+                   **{k: v for k, v in zip(_SPECIMEN_GIVEN_KEYS, key[2:], strict=True) if v}}
         subject = names[0] if len(names) == 1 else f"{_listed(names)} ({len(names)} files)"
         notes.extend(assumption_notes(subject, one, files=len(names)))
     return notes

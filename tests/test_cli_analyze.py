@@ -560,7 +560,10 @@ def test_a_file_stating_no_fill_is_saved_as_a_test_of_the_specimen_given(tmp_pat
     assert mine["specimen_sha256"] == load_specimen(spec).hash and mine["assumed"] == {}
     assert not [n for n in mine["notes"] if "paper's coupon" in n]
     # a file stating other particles is not the specimen's test: the coupon is assumed, said
-    assert other["specimen"] is None and other["assumed"] == {"specimen": "paper_coupon"}
+    # naming the specimen given (no fill stated: the file's particles are not in the record)
+    assert other["specimen"] is None and other["assumed"] == {
+        "specimen": "paper_coupon", "specimen_given": "my_steel",
+        "specimen_given_material": "steel"}
     saved = Store(store).list_analyses().set_index("source")
     assert saved.loc[str(bare), "specimen"] == "my_steel"
     assert saved.loc[str(bare), "specimen_sha256"] == load_specimen(spec).hash

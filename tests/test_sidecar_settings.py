@@ -431,6 +431,40 @@ def test_another_specimen_s_row_taking_the_given_specimen_s_particles_is_said(tm
             "column") in rec["notes"]
 
 
+def test_a_specimen_given_of_other_particles_than_the_file_s_is_named_in_the_note(tmp_path,
+                                                                                 capsys):
+    # `analyze run_fill50_acrylic.csv --specimen steel_6mm.toml` said "no specimen named, ...
+    # name another with --specimen FILE" though one was: the file is the paper's coupon's
+    # because its acrylic particles are not the specimen's steel
+    from pidcore.cli._vocabulary import cli_words
+    from pidcore.report import make_report
+    from pidcore.specimen import load_specimen
+
+    path = export(tmp_path / "run_fill50_acrylic.csv")
+    steel = SAMPLES / "specimens" / "steel_6mm.toml"
+    said = ("run_fill50_acrylic.csv: specimen 'steel_6mm' (--specimen) is of other particles "
+            "(steel) than the file's (acrylic), so the paper's coupon (paper_coupon) with "
+            "acrylic particles is assumed: reports and calibrations compare it with that "
+            "coupon's DEM runs; name a specimen of acrylic particles with --specimen FILE or "
+            "a sidecar's specimen column")
+    assert main(["analyze", str(path), "--no-store", "--specimen", str(steel)]) == 0
+    out = capsys.readouterr().out
+    assert f"note: {said}" in out.splitlines() and "no specimen named" not in out
+    (rec,) = run_json([str(path), "--no-store", "--specimen", str(steel)], capsys)["records"]
+    assert rec["specimen"] is None and rec["load_case"].endswith("_acrylic_z")
+    assert rec["assumed"] == {"specimen": "paper_coupon", "specimen_given": "steel_6mm",
+                              "specimen_given_material": "steel", "file_material": "acrylic"}
+    assert [n for n in rec["notes"] if "paper's coupon" in n] == [said]
+    # the report says it alike (its notes, grouped by file, are the same sentences)
+    result = make_report([path], out_dir=tmp_path / "rep", formats="csv",
+                         specimen=load_specimen(steel))
+    assert [cli_words(n, "report") for n in result.notes if "paper's coupon (" in n] == [said]
+    # without --specimen the note is as before: none was named
+    (rec,) = run_json([str(path), "--no-store"], capsys)["records"]
+    assert rec["assumed"] == {"specimen": "paper_coupon"}
+    assert SPECIMEN_ASSUMED.format(name=path.name) in rec["notes"]
+
+
 def test_report_notes_say_which_material_and_specimen_were_assumed(tmp_path):
     from pidcore.cli._vocabulary import cli_words
     from pidcore.report import make_report
