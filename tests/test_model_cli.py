@@ -14,6 +14,7 @@ import pytest
 from pidcore.cli import model as model_cli
 from pidcore.errors import ParameterError
 from pidcore.model import SdcModel, coupon_vibrated_mass_kg, load_paper_table3
+from pidcore.out_folder import RECORD_NAME
 
 
 def _run(argv: list[str]) -> int:
@@ -129,7 +130,7 @@ def test_figures_writes_every_family(tmp_path, monkeypatch):
     monkeypatch.setattr(Figure, "savefig", save_undrawn)
     assert _run(["model", "figures", "--out", str(tmp_path)]) == 0
     assert len({id(fig) for fig in built}) == 4 + 3  # one figure per family, saved twice
-    names = sorted(p.name for p in tmp_path.iterdir())
+    names = sorted(p.name for p in tmp_path.iterdir() if p.name != RECORD_NAME)
     assert len(names) == 2 * (4 + 3)
     assert "sdc_vs_acceleration_fill90.svg" in names and "sdc_vs_frequency_10g.png" in names
 
@@ -860,7 +861,7 @@ def test_the_out_folder_holds_one_runs_outputs_alone_and_foreign_files_are_refus
                  *grid]) == 0
     assert main(["model", "damper", "--out", str(out), "--format", "json", "--fills", "75",
                  *grid]) == 0
-    assert sorted(p.name for p in out.iterdir()) == ["equivalent_damper.json"]
+    assert sorted(p.name for p in out.iterdir()) == [RECORD_NAME, "equivalent_damper.json"]
     records = json.loads((out / "equivalent_damper.json").read_text())["records"]
     assert [r["packing ratio [%]"] for r in records] == [75.0]
     # no build folder left beside it
@@ -869,7 +870,8 @@ def test_the_out_folder_holds_one_runs_outputs_alone_and_foreign_files_are_refus
     monkeypatch.setattr(Figure, "savefig", lambda fig, target, **_: target.write(b"x"))
     figures = tmp_path / "f"
     assert main(["model", "figures", "--out", str(figures)]) == 0
-    assert len(list(figures.iterdir())) == 2 * (4 + 3)  # Table 3: 4 fills, 3 accelerations
+    # Table 3: 4 fills, 3 accelerations; and the record of the files written
+    assert len(list(figures.iterdir())) == 2 * (4 + 3) + 1
     two_fills = _specimen_runs("steel_6mm", "a" * 64, coupon_kg=0.05, fixture_kg=0.12,
                                sdc_scale=0.5)
     _fake_store(monkeypatch, lambda: two_fills[two_fills["fill_percent"].isin([25.0, 50.0])])
@@ -886,13 +888,67 @@ def test_the_out_folder_holds_one_runs_outputs_alone_and_foreign_files_are_refus
     assert main(["model", "damper", "--out", str(out), "--fills", "50", *grid]) == 2
     assert capsys.readouterr().err == (
         f"pidcore model damper: error: --out {out}: holds 'notes.txt', which pidcore model "
-        "damper does not write and replacing its earlier outputs whole would delete; move it "
-        "out or choose a new or empty folder for --out\n")
+        "damper did not write there and replacing its earlier outputs whole would delete; move "
+        "it out or choose a new or empty folder for --out\n")
     assert (out / "notes.txt").read_text() == "keep me"
     assert (out / "equivalent_damper.json").is_file()
     assert main(["model", "figures", "--out", str(tmp_path / "d")]) == 2
-    assert "holds 'equivalent_damper.json', which pidcore model figures does not write" \
+    assert (f"holds the outputs of pidcore model damper (its {RECORD_NAME}), which pidcore "
+            "model figures does not write") in capsys.readouterr().err
+
+
+def _run_main(argv: list[str]) -> int:
+    from pidcore.cli import main
+
+    return main(argv)
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {p.relative_to(folder).as_posix(): p.read_bytes()
+            for p in folder.rglob("*") if p.is_file()}
+
+
+def test_a_file_named_like_an_output_but_not_written_by_the_run_is_refused_and_kept(
+        tmp_path, monkeypatch, capsys):
+    # any sdc_vs_frequency_*.png was taken for model figures' own by its name and deleted
+    # with the earlier figures: only the files the last run recorded are replaced
+    from matplotlib.figure import Figure
+
+    monkeypatch.setattr(Figure, "savefig", lambda fig, target, **_: target.write(b"x"))
+    figures = tmp_path / "f"
+    assert _run_main(["model", "figures", "--out", str(figures)]) == 0
+    (figures / "sdc_vs_frequency_mydata.png").write_bytes(b"my plot")
+    before = _files(figures)
+    capsys.readouterr()
+    assert _run_main(["model", "figures", "--out", str(figures)]) == 2
+    assert capsys.readouterr().err == (
+        f"pidcore model figures: error: --out {figures}: holds 'sdc_vs_frequency_mydata.png', "
+        "which pidcore model figures did not write there and replacing its earlier outputs "
+        "whole would delete; move it out or choose a new or empty folder for --out\n")
+    assert _files(figures) == before
+    # an output of the run edited since is refused too (the edit would be lost)...
+    (figures / "sdc_vs_frequency_mydata.png").unlink()
+    (figures / "sdc_vs_frequency_5g.png").write_bytes(b"annotated")
+    assert _run_main(["model", "figures", "--out", str(figures)]) == 2
+    assert "holds 'sdc_vs_frequency_5g.png' changed since pidcore model figures wrote it" \
         in capsys.readouterr().err
+    # ...and one deleted since is no loss: the folder is replaced, the figure back as drawn
+    (figures / "sdc_vs_frequency_5g.png").unlink()
+    assert _run_main(["model", "figures", "--out", str(figures)]) == 0
+    assert (figures / "sdc_vs_frequency_5g.png").read_bytes() == b"x"
+
+
+def test_a_folder_of_an_earlier_pidcore_without_a_record_is_refused_not_guessed_at(
+        tmp_path, capsys):
+    out = tmp_path / "d"
+    out.mkdir()
+    (out / "equivalent_damper.csv").write_text("of a pidcore that kept no record")
+    assert _run_main(["model", "damper", "--out", str(out), "--fills", "50"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"pidcore model damper: error: --out {out}: is not empty "
+                          "('equivalent_damper.csv', ...) and holds no record of what pidcore "
+                          f"wrote there ({RECORD_NAME}") and err.count("\n") == 1
+    assert _files(out) == {"equivalent_damper.csv": b"of a pidcore that kept no record"}
 
 
 def test_figures_say_once_which_characters_they_could_not_draw(tmp_path, monkeypatch, capsys):

@@ -333,7 +333,7 @@ def test_a_store_kept_in_an_earlier_report_folder_is_never_replaced_with_it(tmp_
     assert main(["report", str(file), "--store", str(store), "--dem-store", str(dem_store),
                  "--out", str(out), "--format", "csv"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "also holds 's.h5', which a report does not write" in err
+    assert err.count("\n") == 1 and "holds 's.h5', which pidcore report did not write" in err
     assert store.read_bytes() == before and (out / "report.csv").read_bytes() == report_csv
     # an earlier report holding only what a report writes is replaced as before
     store.unlink()

@@ -13,6 +13,7 @@ from matplotlib.figure import Figure
 
 from pidcore.errors import ParameterError
 from pidcore.model import load_paper_table3
+from pidcore.out_folder import RECORD_NAME
 from pidcore.report import (
     RENDERERS,
     REPORT_MARKER,
@@ -179,7 +180,8 @@ def test_success_replaces_an_earlier_report(tmp_path, table, provenance):
     out = tmp_path / "out"
     write_report(table, _figures(), provenance, out, "all")
     paths = write_report(table, {}, provenance, out, "csv")
-    assert sorted(p.name for p in out.iterdir()) == sorted([REPORT_MARKER, "report.csv",
+    assert sorted(p.name for p in out.iterdir()) == sorted([REPORT_MARKER, RECORD_NAME,
+                                                            "report.csv",
                                                             "report.provenance.txt"])
     assert paths == {"csv": out / "report.csv", "csv_provenance": out / "report.provenance.txt"}
 
@@ -189,6 +191,71 @@ def test_unrelated_folder_is_never_replaced(tmp_path, table, provenance):
     with pytest.raises(ParameterError, match="choose a new or empty folder"):
         write_report(table, {}, provenance, tmp_path, "csv")
     assert [p.name for p in tmp_path.iterdir()] == ["mine.txt"]
+
+
+def _snapshot(folder):
+    return {p.relative_to(folder).as_posix(): p.read_bytes()
+            for p in folder.rglob("*") if p.is_file()}
+
+
+@pytest.mark.parametrize("added", ["figures/my_annotated_plot.png", "cases/mysheet.pdf"])
+def test_a_file_added_to_an_earlier_report_is_refused_naming_it_and_kept(tmp_path, table,
+                                                                         provenance, added):
+    # a user's figures/*.png or cases/*.pdf was taken for the report's own by its name alone,
+    # and deleted with the earlier report (exit 0); only what the report wrote is replaced
+    out = tmp_path / "rp"
+    write_report(table, _figures(), provenance, out, "csv", case_sheets={"c1.pdf": b"%PDF-1"})
+    (out / added).parent.mkdir(exist_ok=True)
+    (out / added).write_bytes(b"mine")
+    before = _snapshot(out)
+    with pytest.raises(ParameterError) as caught:
+        write_report(table, {}, provenance, out, "csv")
+    assert str(caught.value) == (
+        f"out_dir {out}: holds {added!r}, which pidcore report did not write there and "
+        "replacing its earlier outputs whole would delete; move it out or choose a new or "
+        "empty folder for out_dir")
+    assert _snapshot(out) == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rp"]  # no build folder left
+    # moved out, the earlier report alone is replaced as before
+    (out / added).unlink()
+    write_report(table, {}, provenance, out, "csv")
+    assert sorted(p.name for p in out.iterdir()) == sorted([REPORT_MARKER, RECORD_NAME,
+                                                            "report.csv",
+                                                            "report.provenance.txt"])
+
+
+def test_an_edited_report_file_is_refused_and_a_deleted_one_is_no_loss(tmp_path, table,
+                                                                        provenance):
+    out = tmp_path / "rp"
+    write_report(table, _figures(), provenance, out, ("csv", "md"))
+    # the user's edit of the written report.md would be lost with it: refused
+    (out / "report.md").write_text("my annotated report", encoding="utf-8")
+    before = _snapshot(out)
+    with pytest.raises(ParameterError, match=r"holds 'report.md' changed since pidcore report "
+                                             r"wrote it, which replacing its earlier outputs "
+                                             r"whole would lose"):
+        write_report(table, {}, provenance, out, "csv")
+    assert _snapshot(out) == before
+    # a written file removed since loses nothing: the report is replaced
+    (out / "report.md").unlink()
+    (out / "figures" / "parabola.svg").unlink()
+    write_report(table, {}, provenance, out, "csv")
+    assert not (out / "figures").exists() and (out / "report.csv").is_file()
+
+
+def test_a_folder_with_no_record_of_its_files_is_refused_even_an_earlier_versions_report(
+        tmp_path, table, provenance):
+    # an earlier pidcore's report folder records no files: a figure of the user's in it
+    # cannot be told from the report's, so it is refused rather than guessed at
+    out = tmp_path / "rp"
+    write_report(table, _figures(), provenance, out, "csv")
+    (out / RECORD_NAME).unlink(missing_ok=True)  # as an earlier pidcore wrote it
+    before = _snapshot(out)
+    with pytest.raises(ParameterError) as caught:
+        write_report(table, {}, provenance, out, "csv")
+    assert str(caught.value).startswith(f"out_dir {out}: is not empty (") and \
+        f"holds no record of what pidcore wrote there ({RECORD_NAME}" in str(caught.value)
+    assert _snapshot(out) == before
 
 
 def test_parse_formats():
@@ -208,14 +275,14 @@ def test_ctrl_c_says_whether_the_report_was_written(tmp_path, table, provenance,
     import os
     import signal
 
+    import pidcore.out_folder as out_folder
     import pidcore.report.pipeline as pipeline
-    import pidcore.report.render as render
     from pidcore.cli import main
 
     out = tmp_path / "rp"
     write_report(table, {}, provenance, out, "csv")
     old_csv = (out / "report.csv").read_bytes()
-    move = render._move_into_place
+    move = out_folder.replace_folder
 
     def sigint_during_the_swap(tmp, out_dir):
         move(tmp, out_dir)
@@ -224,7 +291,7 @@ def test_ctrl_c_says_whether_the_report_was_written(tmp_path, table, provenance,
     def make_report(files, *, out_dir, **kwargs):
         if moment == "before the write":
             raise KeyboardInterrupt
-        monkeypatch.setattr(render, "_move_into_place", sigint_during_the_swap)
+        monkeypatch.setattr(out_folder, "replace_folder", sigint_during_the_swap)
         write_report(table.iloc[:1], {}, provenance, out_dir, "csv")
         raise AssertionError("the interrupt was not delivered after the swap")
 
@@ -375,7 +442,7 @@ def test_every_report_file_is_on_disk_before_the_rename_that_names_it(tmp_path, 
     out = tmp_path / "report"
     write_report(table, _figures(), provenance, out, ("csv", "md"))
     files = {p.stat().st_ino for p in out.rglob("*") if p.is_file()}
-    assert len(files) == 6  # csv, its notes, md, marker, the figure's png and svg
+    assert len(files) == 7  # csv, its notes, md, marker, record, the figure's png and svg
     assert renamed_after and files <= renamed_after[0]
 
 
@@ -420,7 +487,8 @@ def test_a_killed_reports_build_folder_is_removed_by_the_next_report_of_that_fol
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(["rp", names["fresh"],
                                                                  names["user's"]])
     # the report itself landed whole: the marker, the table and its notes, nothing else
-    assert sorted(p.name for p in out.iterdir()) == sorted([REPORT_MARKER, "report.csv",
+    assert sorted(p.name for p in out.iterdir()) == sorted([REPORT_MARKER, RECORD_NAME,
+                                                            "report.csv",
                                                             "report.provenance.txt"])
     assert len(pd.read_csv(paths["csv"])) == len(table)
 
@@ -531,6 +599,7 @@ from datetime import UTC, datetime
 import pandas as pd
 
 from pidcore.model import load_paper_table3
+from pidcore.out_folder import RECORD_NAME
 from pidcore.report import build_report_table, collect_provenance, write_report
 
 dem = pd.DataFrame({"frequency_hz": [50.0, 500.0], "acceleration_g": [5.0, 5.0],

@@ -3,8 +3,8 @@
 ``pidcore model damper --out DIR [--table paper|store] [--store FILE] [--format csv,json]``
 writes the equivalent-damper table; ``pidcore model figures --out DIR`` writes the SDC figure
 families (paper Figs. 8-14) as PNG and SVG. Each replaces its ``--out`` folder's outputs
-whole, as ``report --out`` does (:mod:`._out_folder`). All logic is in :mod:`pidcore.model` and
-:mod:`pidcore.report.figures`.
+whole, as ``report --out`` does (:mod:`pidcore.out_folder`). All logic is in
+:mod:`pidcore.model` and :mod:`pidcore.report.figures`.
 """
 
 from __future__ import annotations
@@ -17,8 +17,8 @@ from pathlib import Path
 from .. import defaults
 from ..constants import PARTICLE_MATERIALS, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError, as_given
+from ..out_folder import check_replaceable, write_folder_whole
 from ._options import add_store_option, check_out_folder, command_line, path_argument
-from ._out_folder import check_replaceable, write_folder_whole
 
 
 def _float_list(text: str) -> list[float]:
@@ -234,19 +234,6 @@ def _cli_where(message: str, where: dict) -> str:
 DAMPER_STEM = "equivalent_damper"
 
 
-def _damper_file(name: str) -> bool:
-    return name in {f"{DAMPER_STEM}.csv", f"{DAMPER_STEM}.json"}
-
-
-def _figure_file(name: str) -> bool:
-    """A figure ``model figures`` writes (``sdc_vs_acceleration_fill50.png``,
-    ``sdc_vs_frequency_5g.svg``)."""
-    import re
-
-    return re.fullmatch(r"sdc_vs_(acceleration_fill|frequency_)[^/]*\.(png|svg)", name) \
-        is not None
-
-
 def run_damper(args: argparse.Namespace) -> int:
     from ..model.damper import (
         SDC_FILLED_COLUMN,
@@ -263,10 +250,10 @@ def run_damper(args: argparse.Namespace) -> int:
         write_damper_table,
     )
 
-    check_out_folder(args.out)
+    check_out_folder(args.out, built_beside=True)
     # a CSV of an earlier run at 50 % was left beside this run's JSON at 75 %: the folder is
     # replaced whole, and one holding other files refused before any work
-    check_replaceable(args.out, _damper_file, "model damper")
+    check_replaceable(args.out, "model damper", option="--out")
     # the table takes a value typed twice once (equivalent_damper_table): said here
     for option in ("fills", "accelerations", "frequencies"):
         given = getattr(args, option)
@@ -438,9 +425,9 @@ def run_damper(args: argparse.Namespace) -> int:
     if undefined:
         provenance["damping_ratio"] = why
     paths = write_folder_whole(
-        args.out, _damper_file, "model damper",
+        args.out, "model damper",
         lambda folder: write_damper_table(table, folder, formats=args.format, stem=DAMPER_STEM,
-                                          provenance=provenance))
+                                          provenance=provenance), option="--out")
     for path in paths:
         print(path)
     print(f"pidcore model damper: note: coupon area {area_text}", file=sys.stderr)
@@ -493,9 +480,9 @@ def run_figures(args: argparse.Namespace) -> int:
     from ..report.figures import plot_sdc_vs_acceleration, plot_sdc_vs_frequency, save_figure
     from ..report.fonts import figure_fonts, missing_glyphs_note
 
-    check_out_folder(args.out)
+    check_out_folder(args.out, built_beside=True)
     # the figures of fills an earlier model had stayed beside this one's
-    check_replaceable(args.out, _figure_file, "model figures")
+    check_replaceable(args.out, "model figures", option="--out")
     if args.specimen is not None and args.table == "paper":
         raise ParameterError(f"--specimen {args.specimen}: selects DEM runs: use it with "
                              "--table store (--table paper draws the paper's coupon)")
@@ -519,7 +506,7 @@ def run_figures(args: argparse.Namespace) -> int:
         return paths
 
     with figure_fonts() as missing:  # a specimen's or store's name in CJK in the titles
-        paths = write_folder_whole(args.out, _figure_file, "model figures", draw)
+        paths = write_folder_whole(args.out, "model figures", draw, option="--out")
     for path in paths:
         print(path)
     if missing:

@@ -19,23 +19,17 @@ import html
 import math
 import os
 import re
-import shutil
 import textwrap
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 
 import pandas as pd
 
-from .. import defaults, interrupt
-from ..atomic_files import (
-    fsync_tree,
-    new_temporary_folder_for,
-    replace_folder,
-    restore_previous_folder,
-)
+from .. import defaults
+from ..atomic_files import restore_previous_folder
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError
-from ..io import display_path
+from ..out_folder import check_replaceable, write_folder_whole
 from ..units import value_and_error_texts
 from .provenance import Provenance
 from .table import (
@@ -52,8 +46,11 @@ from .table import (
     shared_identity,
 )
 
-#: File written into every report folder; only folders holding it are ever replaced.
+#: File written into every report folder: a folder a killed replacement left hidden beside its
+#: place is put back only where it holds it (:func:`restore_previous_report`).
 REPORT_MARKER = ".pidcore-report"
+#: The command whose outputs a report folder's record lists (:mod:`pidcore.out_folder`).
+REPORT_COMMAND = "report"
 #: Base name of the table files (``report.csv``, ``report.md``...).
 REPORT_STEM = "report"
 #: Folder of a report's load-case PDF sheets (``pidcore report --case-sheets``).
@@ -731,53 +728,21 @@ def save_figure_files(fig: object, folder: Path, stem: str, *,
 
 
 def check_out_dir(out_dir: Path) -> None:
-    """Refuse an output path that is a file or an unrelated non-empty folder (never replaced),
-    or one under a file (no folder can be made there)."""
+    """Refuse an output path that is a file, one under a file (no folder can be made there),
+    or a folder whose replacement would lose anything that is not an earlier report's
+    unchanged output (:func:`pidcore.out_folder.check_replaceable`)."""
     from ..atomic_files import file_in_the_way
 
     blocking = file_in_the_way(out_dir)
     if blocking is not None:
         raise ParameterError(f"{out_dir}: {blocking} is a file, not a folder; expected a "
                              "report output folder under a folder")
-    if out_dir.exists():
-        if not out_dir.is_dir():
-            raise ParameterError(f"{out_dir}: report output exists and is not a folder")
-        if any(out_dir.iterdir()) and not (out_dir / REPORT_MARKER).exists():
-            raise ParameterError(f"{out_dir}: folder exists, is not empty and holds no earlier "
-                                 "pidcore report; choose a new or empty folder for out_dir")
-        foreign = _not_written_by_a_report(out_dir)
-        if foreign:
-            # the folder is replaced whole: a store kept in an earlier report's folder
-            # (report FILES --store rp/s.h5 --out rp) was deleted with the analyses just saved
-            raise ParameterError(
-                f"{out_dir}: an earlier pidcore report, but it also holds {foreign!r}, which a "
-                "report does not write and replacing the report would delete; move it out or "
-                "choose another folder for out_dir")
-
-
-def _not_written_by_a_report(out_dir: Path) -> str:
-    """The first entry of an earlier report folder that a report does not write ("" if
-    none): its files, the CSV's notes, the marker, PNG/SVG files in ``figures`` and PDF
-    sheets in :data:`CASE_SHEETS_FOLDER`."""
-    folders = {"figures": (".png", ".svg"), CASE_SHEETS_FOLDER: (".pdf",)}
-    ours = {REPORT_MARKER, *folders, f"{REPORT_STEM}{CSV_NOTES_SUFFIX}",
-            *(f"{REPORT_STEM}.{ext}" for ext in REPORT_FORMATS)}
-    for entry in sorted(out_dir.iterdir()):
-        if entry.name not in ours or (entry.name in folders) != entry.is_dir() \
-                or entry.is_symlink():
-            return display_path(entry.name)
-    for name, suffixes in folders.items():
-        folder = out_dir / name
-        if folder.is_dir():
-            for entry in sorted(folder.iterdir()):
-                if entry.suffix not in suffixes or not entry.is_file() \
-                        or entry.is_symlink():
-                    return display_path(f"{name}/{entry.name}")
-    return ""
-
-
-def _move_into_place(tmp: Path, out_dir: Path) -> None:
-    replace_folder(tmp, out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise ParameterError(f"{out_dir}: report output exists and is not a folder")
+    # the folder is replaced whole: a store kept in an earlier report's folder (report FILES
+    # --store rp/s.h5 --out rp) was deleted with the analyses just saved, and a user's
+    # figures/my_plot.png with it
+    check_replaceable(out_dir, REPORT_COMMAND, option="out_dir")
 
 
 def restore_previous_report(out_dir: str | Path) -> Path | None:
@@ -787,8 +752,11 @@ def restore_previous_report(out_dir: str | Path) -> Path | None:
     folder left after the replacement had finished. Returns the folder restored, None if
     none was (:func:`restored_report_note` says so); a ``ParameterError`` where several are
     hidden beside a missing ``out_dir``. :func:`write_report` calls it first."""
-    return restore_previous_folder(
-        out_dir, is_previous=lambda folder: (folder / REPORT_MARKER).is_file())
+    return restore_previous_folder(out_dir, is_previous=_is_report)
+
+
+def _is_report(folder: Path) -> bool:
+    return (folder / REPORT_MARKER).is_file()
 
 
 def restored_report_note(out_dir: str | Path) -> str:
@@ -813,7 +781,8 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
     provenance : Provenance
         Footer of every format.
     out_dir : path
-        Output folder. It must be new, empty or an earlier pidcore report (which is replaced).
+        Output folder. It must be new, empty or an earlier pidcore report holding its own
+        unchanged files alone (which is replaced; :mod:`pidcore.out_folder`).
     formats : str or iterable of str
         Any of ``csv, md, html, tex, pdf`` or ``"all"``.
     progress : bool
@@ -843,8 +812,6 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
     out_dir = Path(out_dir)
     restore_previous_report(out_dir)  # before the check: a hidden report is the earlier one
     check_out_dir(out_dir)
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = new_temporary_folder_for(out_dir)
     written: dict[str, Path] = {}
     bar = None
     if progress:
@@ -853,7 +820,8 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
         bar = tqdm(total=len(figures) + len(formats) + len(case_sheets), unit="file",
                    desc="writing report",
                    leave=False, dynamic_ncols=True)
-    try:
+
+    def build(tmp: Path) -> list[Path]:
         pngs: dict[str, Path] = {}
         for stem, fig in figures.items():
             png, svg = save_figure_files(fig, tmp / "figures", stem)
@@ -884,19 +852,16 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
         if bar is not None:
             bar.close()  # before the "wrote ..." lines
         (tmp / REPORT_MARKER).write_text("written by pidcore report\n", encoding="utf-8")
-        os.chmod(tmp, 0o755)  # a report folder is meant to be shared, whatever the umask
-        fsync_tree(tmp)  # the files on disk before the rename that names them
-        # the swap and the earlier report's removal are one step for Ctrl-C: cut between them,
-        # a '.<name>.*.old' folder was left beside the report (interrupt.deferred)
-        with interrupt.deferred():
-            _move_into_place(tmp, out_dir)
-    except BaseException:
+        return list(written.values())
+
+    try:
+        # a report folder is meant to be shared, whatever the umask: mode 0o755
+        paths = write_folder_whole(out_dir, REPORT_COMMAND, build, option="out_dir",
+                                   mode=0o755, is_previous=_is_report)
+    finally:
         if bar is not None:
             bar.close()
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    interrupt.raise_if_interrupted()
-    return {k: out_dir / p.relative_to(tmp) for k, p in written.items()}
+    return dict(zip(written, paths, strict=True))
 
 
 def folder_identity(folder: str | Path) -> tuple[int, int] | None:
