@@ -16,6 +16,10 @@ deleted. So is refused, naming it:
   replacement would lose; a listed file deleted since loses nothing and is no refusal);
 * a folder that is not empty and holds no record, or another command's: an earlier pidcore
   kept none, and its outputs cannot be told from files added to them since.
+
+An ``--out`` that is a link to a folder stays a link: the folder it points to is the one
+replaced, built beside that folder (a link renamed over was replaced by a real folder, and the
+folder it pointed to left as it was).
 """
 
 from __future__ import annotations
@@ -38,6 +42,13 @@ from .errors import ParameterError
 #: The record a run writes into its output folder: ``{"written_by": "pidcore <command>",
 #: "files": {path in the folder (``/``-separated): SHA-256 of its bytes}}``.
 RECORD_NAME = ".pidcore-outputs.json"
+
+
+def real_folder(out: str | os.PathLike[str]) -> Path:
+    """The folder an ``--out`` names: where it is a link, the folder the link points to (every
+    link resolved), which is replaced while the link is kept; else ``out`` itself."""
+    out = Path(out)
+    return Path(os.path.realpath(out)) if out.is_symlink() else out
 
 
 def _sha256(path: Path) -> str:
@@ -125,9 +136,10 @@ def check_replaceable(out: str | os.PathLike[str], command: str, *, option: str)
     words (the library's ``"out_dir"``, the command line's flag); a new or empty folder, or the
     unchanged outputs of the command's last run there, are taken."""
     out = Path(out)
-    if not out.is_dir():
+    real = real_folder(out)
+    if not real.is_dir():
         return
-    why = _not_its_own(out, command)
+    why = _not_its_own(real, command)
     if why:
         raise ParameterError(f"{option} {out}: {why}; move it out or choose a new or empty "
                              f"folder for {option}")
@@ -137,7 +149,7 @@ def write_folder_whole(out: str | os.PathLike[str], command: str,
                        build: Callable[[Path], Iterable[str | os.PathLike[str]]], *,
                        option: str, mode: int | None = None,
                        is_previous: Callable[[Path], bool] | None = None) -> list[Path]:
-    """Write ``pidcore command``'s outputs into ``out``, replacing those of
+    """Write ``pidcore command``'s outputs into ``out`` (its link's folder), replacing those of
     its last run there: ``build`` writes them into the folder it is given and returns their
     paths, which are returned as they lie under ``out``.
 
@@ -148,11 +160,12 @@ def write_folder_whole(out: str | os.PathLike[str], command: str,
     ``is_previous``: which hidden folder is an earlier one, default one of this command's
     records)."""
     out = Path(out)
+    real = real_folder(out)
     restore_previous_folder(  # first: a hidden one is the earlier
-        out, is_previous=is_previous or (lambda folder: written_by(folder, command)))
+        real, is_previous=is_previous or (lambda folder: written_by(folder, command)))
     check_replaceable(out, command, option=option)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    work = new_temporary_folder_for(out)
+    real.parent.mkdir(parents=True, exist_ok=True)
+    work = new_temporary_folder_for(real)
     try:
         paths = [Path(p) for p in build(work)]
         _write_record(work, command)
@@ -162,7 +175,7 @@ def write_folder_whole(out: str | os.PathLike[str], command: str,
         # the swap and the earlier folder's removal are one step for Ctrl-C: cut between
         # them, a '.<name>.*.old' folder was left beside it
         with interrupt.deferred():
-            replace_folder(work, out)
+            replace_folder(work, real)
     except BaseException:
         shutil.rmtree(work, ignore_errors=True)
         raise

@@ -972,3 +972,21 @@ def test_figures_say_once_which_characters_they_could_not_draw(tmp_path, monkeyp
         assert err.count("could not be drawn") == 1
         assert "pidcore model figures: note: 1 character(s) could not be drawn in the " \
                "figures (鋼)" in err
+
+
+def test_an_out_that_links_to_a_folder_keeps_the_link_and_its_folder_gets_the_outputs(
+        tmp_path):
+    # `ln -s realout linkout; model damper --out linkout` replaced the link by a real folder
+    # and left realout empty
+    real, link = tmp_path / "realout", tmp_path / "linkout"
+    real.mkdir()
+    link.symlink_to(real.name)  # relative, as ln -s writes it
+    grid = ["--fills", "50", "--accelerations", "5", "--frequencies", "100"]
+    assert _run_main(["model", "damper", "--out", str(link), "--format", "csv", *grid]) == 0
+    assert link.is_symlink() and link.readlink() == Path("realout")
+    assert sorted(p.name for p in real.iterdir()) == [RECORD_NAME, "equivalent_damper.csv"]
+    # replaced again through the link: its folder holds this run's outputs alone
+    assert _run_main(["model", "damper", "--out", str(link), "--format", "json", *grid]) == 0
+    assert link.is_symlink()
+    assert sorted(p.name for p in real.iterdir()) == [RECORD_NAME, "equivalent_damper.json"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["linkout", "realout"]

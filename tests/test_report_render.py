@@ -258,6 +258,26 @@ def test_a_folder_with_no_record_of_its_files_is_refused_even_an_earlier_version
     assert _snapshot(out) == before
 
 
+def test_an_out_dir_that_links_to_a_folder_is_replaced_where_it_points_and_stays_a_link(
+        tmp_path, table, provenance):
+    # `ln -s real link; pidcore report --out link`: the link was renamed over by a real
+    # folder and the report it pointed to left as it was
+    real, link = tmp_path / "real", tmp_path / "link"
+    write_report(table, _figures(), provenance, real, "all")
+    link.symlink_to(real)
+    paths = write_report(table, {}, provenance, link, "csv")
+    assert link.is_symlink() and link.resolve() == real.resolve()
+    assert sorted(p.name for p in real.iterdir()) == sorted([REPORT_MARKER, RECORD_NAME,
+                                                             "report.csv",
+                                                             "report.provenance.txt"])
+    assert paths["csv"] == link / "report.csv"  # as the user named it
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["link", "real"]
+    # a link to a folder yet to be made gets it, made where it points
+    (tmp_path / "dangling").symlink_to(tmp_path / "later")
+    write_report(table, {}, provenance, tmp_path / "dangling", "csv")
+    assert (tmp_path / "dangling").is_symlink() and (tmp_path / "later" / "report.csv").is_file()
+
+
 def test_parse_formats():
     assert parse_formats("all") == ("csv", "md", "html", "tex", "pdf")
     assert parse_formats("pdf,csv,pdf") == ("pdf", "csv")

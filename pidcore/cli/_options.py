@@ -99,6 +99,7 @@ def check_out_folder(out: Path, *, built_beside: bool = False) -> None:
     (:func:`pidcore.atomic_files.new_temporary_folder_for`). Checked before any work, so a
     long run is not thrown away at the end."""
     from ..atomic_files import check_folder_can_be_made, file_in_the_way
+    from ..out_folder import real_folder
 
     if out.exists() and not out.is_dir():
         raise ParameterError(f"--out {out}: exists and is not a folder")
@@ -108,7 +109,9 @@ def check_out_folder(out: Path, *, built_beside: bool = False) -> None:
     if out.is_dir():  # a build folder's name in it: its files' temporaries are made there
         check_folder_can_be_made(out / "out", label=f"--out {out}")
     if built_beside or not out.is_dir():
-        check_folder_can_be_made(out, label=f"--out {out}")
+        # a link's folder is replaced where it lies, built beside it (pidcore.out_folder)
+        for place in dict.fromkeys((out, real_folder(out))):
+            check_folder_can_be_made(place, label=f"--out {out}")
 
 
 def add_store_option(p: argparse.ArgumentParser, *, flag: str = "--store",

@@ -34,6 +34,7 @@ from ..errors import ParameterError, StoreError
 from ..interrupt import untouched
 from ..io import display_path
 from ..loadcase import refuse_identical_contents_stating_apart
+from ..out_folder import real_folder
 from .provenance import calibration_provenance, collect_provenance
 from .render import (
     CASE_SHEETS_FOLDER,
@@ -969,8 +970,8 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
     # a hidden earlier report back before the check (write_report would do it silently)
     restored = restore_previous_report(out_dir) is not None
     check_out_dir(out_dir)
-    # the report is built beside out_dir and renamed into place (write_report)
-    check_folder_can_be_made(out_dir)
+    # the report is built beside out_dir (a link's folder) and renamed into place
+    check_folder_can_be_made(real_folder(out_dir))
     tolerances = tolerances or Tolerances()
     files = [Path(f) for f in files]
     if not files and store is None and dem_store is None:

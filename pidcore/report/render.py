@@ -29,7 +29,7 @@ from .. import defaults
 from ..atomic_files import restore_previous_folder
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError
-from ..out_folder import check_replaceable, write_folder_whole
+from ..out_folder import check_replaceable, real_folder, write_folder_whole
 from ..units import value_and_error_texts
 from .provenance import Provenance
 from .table import (
@@ -752,7 +752,7 @@ def restore_previous_report(out_dir: str | Path) -> Path | None:
     folder left after the replacement had finished. Returns the folder restored, None if
     none was (:func:`restored_report_note` says so); a ``ParameterError`` where several are
     hidden beside a missing ``out_dir``. :func:`write_report` calls it first."""
-    return restore_previous_folder(out_dir, is_previous=_is_report)
+    return restore_previous_folder(real_folder(out_dir), is_previous=_is_report)
 
 
 def _is_report(folder: Path) -> bool:
@@ -781,8 +781,9 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
     provenance : Provenance
         Footer of every format.
     out_dir : path
-        Output folder. It must be new, empty or an earlier pidcore report holding its own
-        unchanged files alone (which is replaced; :mod:`pidcore.out_folder`).
+        Output folder (a link's: the folder it points to). It must be new, empty or an
+        earlier pidcore report holding its own unchanged files alone (which is replaced;
+        :mod:`pidcore.out_folder`).
     formats : str or iterable of str
         Any of ``csv, md, html, tex, pdf`` or ``"all"``.
     progress : bool
