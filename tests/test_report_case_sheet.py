@@ -385,6 +385,24 @@ def test_the_case_sheets_file_table_names_its_sdcs_as_the_report_does(tmp_path, 
     assert "SDC stderr [-]" not in text
 
 
+def test_a_case_sheet_of_a_file_named_like_tex_math_draws_the_name_as_typed(tmp_path):
+    """A test file named ``r$\\x$_c$^$_fill50.csv`` failed the whole report with case sheets
+    in matplotlib's mathtext ("ParseFatalException: Unknown symbol: \\x", exit 1). Its name
+    is text, written on its sheet as it is spelt."""
+    from _app_samples import mass_damper_csv
+
+    path = tmp_path / "r$\\x$_c$^$_fill50.csv"
+    path.write_bytes(mass_damper_csv(frequency_hz=100.0, acceleration_g=5.0, loss_factor=0.05))
+    out = tmp_path / "report"
+    assert main(["report", str(path), "--dem-store", str(DEM_STORE), "--case-sheets",
+                 "--format", "csv", "--out", str(out)]) == 0
+    (sheet,) = (out / "cases").iterdir()
+    text = _pdf_text(sheet.read_bytes())
+    # the PDF splits a string at a kerning step, escapes its backslash and draws "fi" as a
+    # ligature glyph: the parts between them
+    assert "r$" in text and "x$_c$^$_" in text
+
+
 # --- every option that changes the report's rows: each sheet is one row's -------------------
 
 #: The bundled run of 100 Hz, 5 g, 50 % (the paper's coupon), copied as another specimen's.

@@ -19,6 +19,7 @@ from ..atomic_files import (
     move_files_into_folder,
     new_temporary_folder_for,
 )
+from ..plot_text import text_as_typed
 from ..records import json_safe
 from ..specimen import CALIBRATED_SPECIMEN_FILE
 from ..units import display_number
@@ -367,6 +368,7 @@ def draw_cut_bounds(ax: Any, bounds: set[float]) -> None:
                    + ": bands cut here (model unconstrained above)")
 
 
+@text_as_typed
 def predictions_figure(result: CalibrationResult) -> Any:
     """The figure of predictions.png: measured SDC per load case with the
     posterior-predictive 95 % bands (and LOO's), drawn by :func:`draw_bands` (an
@@ -413,6 +415,7 @@ def _write_and_close(fig: Any, path: Path, *, dpi: int) -> None:
         plt.close(fig)
 
 
+@text_as_typed
 def pairs_figure(result: CalibrationResult) -> Any:
     """The figure of posterior_pairs.png: histograms of the posterior samples on the diagonal
     (their count on its axis), scatter below it, each axis labelled with its parameter and

@@ -27,6 +27,7 @@ from ..calibrate.prediction import (
 )
 from ..compare.align import CALIBRATED_INSIDE_COLUMN, PACKING_RATIO_COLUMN
 from ..compare.case import CaseComparison, MeasuredEntry
+from ..plot_text import text_as_typed
 from ..units import display_value_with_error
 from .case_view import case_title, case_view, group_entries
 from .render import bounded_stem
@@ -179,6 +180,7 @@ def sheet_lines(view: dict, *, title: str, calibrated: CalibratedCase | None = N
     return lines
 
 
+@text_as_typed
 def case_pdf(view: dict, *, title: str, calibrated: CalibratedCase | None = None) -> bytes:
     """PDF bytes of one load case from the Compare page's case view
     (:func:`pidcore.report.case_view.case_view`: ``comparison``, ``headline``, ``sdc_points``,

@@ -20,6 +20,7 @@ import pandas as pd
 
 from .. import defaults
 from ..loop import ForceDisplacementLoop
+from ..plot_text import text_as_typed
 from .table import (
     ALIGNMENT_COLUMN,
     MEASURED_EQ10_COLUMN,
@@ -55,6 +56,7 @@ _DRAWN_COLUMNS: tuple[str, ...] = (MEASURED_EQ10_COLUMN, "SDC DEM (ours) [-]",
                                    MEASURED_EQ11_COLUMN)
 
 
+@text_as_typed
 def plot_sdc_comparison(table: pd.DataFrame, *, ax=None):
     """SDC per load case: measured, our DEM and the paper's values side by side.
 
@@ -275,6 +277,7 @@ def _closed(x: np.ndarray, f: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.append(x, x[:1]), np.append(f, f[:1])
 
 
+@text_as_typed
 def plot_loop_overlay(measured: ForceDisplacementLoop | tuple,
                       dem: ForceDisplacementLoop | tuple | None, *,
                       title: str = "", ax=None):

@@ -25,6 +25,7 @@ import pandas as pd
 from ..atomic_files import write_atomically
 from ..errors import ParameterError
 from ..model.sdc_model import SdcModel
+from ..plot_text import text_as_typed
 
 #: Points per curve.
 _CURVE_POINTS = 200
@@ -116,6 +117,7 @@ def _draw_family(model: SdcModel, *, panels: Sequence[float], panel_column: str,
     return fig
 
 
+@text_as_typed
 def plot_sdc_vs_acceleration(model: SdcModel, *, fills: Sequence[float] | None = None,
                              frequencies: Sequence[float] | None = None, ax=None,
                              table: pd.DataFrame | None = None, value: str | None = None):
@@ -148,6 +150,7 @@ def plot_sdc_vs_acceleration(model: SdcModel, *, fills: Sequence[float] | None =
                         xlabel="acceleration amplitude [g]")
 
 
+@text_as_typed
 def plot_sdc_vs_frequency(model: SdcModel, *, accelerations: Sequence[float] | None = None,
                           fills: Sequence[float] | None = None, ax=None,
                           table: pd.DataFrame | None = None, value: str | None = None,

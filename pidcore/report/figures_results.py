@@ -28,6 +28,7 @@ import pandas as pd
 
 from .. import defaults
 from ..errors import ParameterError
+from ..plot_text import text_as_typed
 from ..units import display_value_with_error
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -35,6 +36,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from ..loop import ForceDisplacementLoop
 
 
+@text_as_typed
 def plot_spectrum(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     """Harmonic spectrum: |F_n| (N, left axis) and |V_n| (m/s, right axis). Returns ``ax``.
 
@@ -64,6 +66,7 @@ def plot_spectrum(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     return ax
 
 
+@text_as_typed
 def plot_loop(loop: ForceDisplacementLoop, *, ax: Any = None, **line_kw: Any) -> Any:
     """One closed force-displacement loop, displacement in µm. Returns ``ax``.
 
@@ -81,6 +84,7 @@ def plot_loop(loop: ForceDisplacementLoop, *, ax: Any = None, **line_kw: Any) ->
     return ax
 
 
+@text_as_typed
 def plot_dem_run(result: DemResult, *, ax: Any = None) -> Any:
     """Per-cycle dissipation (top) and wall/shaker force over the last cycles (bottom).
 
@@ -113,6 +117,7 @@ def plot_dem_run(result: DemResult, *, ax: Any = None) -> Any:
     return ax
 
 
+@text_as_typed
 def plot_calibration(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     """Calibrated predictions (points, 95 % band as error bars, cut at each case's SDC bound)
     and the measured SDCs they were fitted to (crosses), one position per load case. A band
@@ -160,6 +165,7 @@ def plot_calibration(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     return ax
 
 
+@text_as_typed
 def calibration_png(frame: pd.DataFrame, *, dpi: int = 150) -> bytes:
     """PNG of :func:`plot_calibration` of ``frame`` (:meth:`pidcore.calibrate.Calibration.
     to_pandas`) on a figure of its own, for a page that shows an image (the app's list of
@@ -181,6 +187,7 @@ def calibration_png(frame: pd.DataFrame, *, dpi: int = 150) -> bytes:
     return buffer.getvalue()
 
 
+@text_as_typed
 def plot_harmonic_response(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     """Displacement amplitude against frequency, with and without the particle damper; points
     where the SDC was held at the model's edge marked. Returns ``ax``.
@@ -205,6 +212,7 @@ def plot_harmonic_response(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     return ax
 
 
+@text_as_typed
 def plot_measurement(frame: pd.DataFrame, *, ax: Any = None) -> Any:
     """Each channel of a measurement against time, one axes per channel, stacked with a shared
     time axis. Returns the axes (one, or an array of them).
