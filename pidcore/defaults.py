@@ -70,7 +70,8 @@ DRIFT_KNOT_PERIODS = 4
 CLIPPING_RELATIVE_TOLERANCE = 1e-9
 #: Run of identical extreme samples that flags a channel as clipped.
 CLIPPING_MIN_RUN = 4
-#: A frequency hint is searched within +- this fraction of itself (and at least +- 3 FFT bins).
+#: A frequency hint may lie within +- this fraction of the drive line (searched with 3 FFT bins
+#: more where a short record's bins are coarser).
 FREQUENCY_SEARCH_RELATIVE_WIDTH = 0.05
 #: The drive peak's power must exceed the median spectral power by this factor (20 dB); the
 #: largest of ~1e6 white-noise bins exceeds the median by ~20 (13 dB), a drive tone by >> 1e3.

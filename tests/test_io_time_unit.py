@@ -220,7 +220,7 @@ def test_a_drive_found_1000_x_the_hint_names_the_time_unit(tmp_path, capsys):
     err = refusal(["analyze", str(path), "--no-store", "--no-progress", "--frequency", "50"],
                   capsys)
     assert err.startswith(f"pidcore analyze: error: {path}: ")
-    assert err.endswith("outside +-5 % of the frequency hint 50 Hz; it is 1000 x the hint, as "
+    assert err.endswith("the frequency hint 50 Hz more than 5 % off it; it is 1000 x the hint, as "
                         "from a time base read in the wrong unit (s read as ms): give the "
                         "file's time unit (--time-unit UNIT) or correct the hint (--frequency) "
                         "or leave it out")

@@ -124,18 +124,36 @@ def test_spline_drift_fit_matches_dense_least_squares_and_keeps_the_segments():
 
 
 @pytest.mark.parametrize("hint, accepted", [(500.0, False), (445.0, False), (441.0, True),
-                                            (401.0, True), (399.0, False)])
+                                            (401.0, True), (399.0, True), (398.0, False)])
 def test_a_hint_more_than_five_percent_off_is_refused_however_short_the_record(hint, accepted):
     """150 samples at 5120 Hz (12.3 periods of 420 Hz): FFT bins of 34 Hz, 8 % of the line.
-    The rule is the README's, 5 % of the hint: the refined line is exact here (noise-free),
-    so 441 Hz (4.8 % above 420) passes and 445 Hz (5.6 %) is refused; 3 bins more accepted
-    a hint of 500 Hz, 16 % off."""
+    The rule is the README's, 5 % of the drive line: the refined line is exact here
+    (noise-free), so 441 and 399 Hz (21 Hz, 5.0 % of 420) pass, 445 Hz (6.0 %) and 398 Hz
+    (5.2 %) are refused; 3 bins more accepted a hint of 500 Hz, 16 % off."""
     fs, f_true = 5120.0, 420.0
     x = np.cos(2 * np.pi * f_true * np.arange(150) / fs + 0.4)
     if accepted:
         assert estimate_drive_frequency(x, fs, frequency_hint_hz=hint) == pytest.approx(
             f_true, rel=1e-9)
     else:
-        with pytest.raises(SignalError, match=rf"420 Hz lies outside \+-5 % of the frequency "
-                                              rf"hint {hint:g} Hz"):
+        with pytest.raises(SignalError, match=rf"drive frequency is 420 Hz, the frequency hint "
+                                              rf"{hint:g} Hz more than 5 % off it"):
+            estimate_drive_frequency(x, fs, frequency_hint_hz=hint)
+
+
+@pytest.mark.parametrize("hint, accepted", [(475.0, True), (525.0, True), (474.9, False),
+                                            (526.3, False)])
+def test_the_five_percent_a_hint_may_be_off_are_of_the_drive_line_not_of_the_hint(hint, accepted):
+    """A 500 Hz line, 2 s at 51.2 kHz, noise-free (refined to ~1e-12): hints 25 Hz off, exactly
+    5 % of the line on either side, pass; 474.9 and 526.3 Hz (5.02 and 5.26 % of it) are
+    refused. The old rule took 5 % of the hint: 475 Hz (23.75 Hz of window) was refused and
+    526.3 Hz (26.3 Hz) accepted."""
+    fs = 51200.0
+    x = np.cos(2 * np.pi * 500.0 * np.arange(102400) / fs + 0.4)
+    if accepted:
+        assert estimate_drive_frequency(x, fs, frequency_hint_hz=hint) == pytest.approx(
+            500.0, rel=1e-9)
+    else:
+        with pytest.raises(SignalError, match=rf"the frequency hint {hint:g} Hz more than 5 % "
+                                              "off it"):
             estimate_drive_frequency(x, fs, frequency_hint_hz=hint)
