@@ -53,10 +53,19 @@ DRIVE_COHERENCE_MAX_LOSS = 0.02
 #: says it: 0.1 % of acceleration, 0.2 % of energy per cycle.
 DRIVE_COHERENCE_NOTED_LOSS = 1e-3
 #: A loss of the drive line's coherence (:data:`DRIVE_COHERENCE_NOTED_LOSS`) is only the drive's
-#: where it exceeds this many times the blocks' relative phasor variance from noise (their
-#: residuals): noise makes a loss of about a quarter of that variance, so 10 leaves a margin
-#: of 40 that 8 blocks' scatter of it does not reach; a sweep's loss does not shrink with it.
+#: where it exceeds this many times the median of the blocks' relative phasor variance from
+#: noise (their residual variance over its degrees of freedom, times the fit's variance factor
+#: of the fundamental): noise makes a loss of about a quarter of that variance times
+#: chi^2(7)/8, so 10 leaves a margin of 40 that 8 blocks' scatter of it does not reach; a
+#: sweep's loss does not shrink with it.
 DRIVE_PHASE_NOISE_FACTOR = 10.0
+#: Fewest degrees of freedom (samples less the fit's 2H + 2 parameters) the blocks' residuals
+#: must hold for the drive's phase to be judged against their noise
+#: (:data:`DRIVE_PHASE_NOISE_FACTOR`); fewer, and the check says nothing. Each block's noise
+#: estimate is chi^2(nu)/nu of the truth: with nu = 1 the median of 8 falls under a tenth of the
+#: loss noise makes in 2e-3 of records (a steady drive refused), with 2 in 6e-6, with 4 under
+#: 1e-6 (2 million draws of that model).
+DRIVE_PHASE_MIN_DOF = 4
 #: Whole drive periods between the knots of the cubic spline that takes up the drift of a
 #: record: a slow wander (a shaker table at 0.3-1 Hz) is not a line over a 2 s record, and one
 #: trend over it leaked the rest into the harmonics (1e-4 of loss factor at 5 %); a spline

@@ -89,6 +89,36 @@ def test_harmonic_fit_matches_dense_least_squares_on_noise():
             assert dc == pytest.approx(coef[0], abs=1e-10)
 
 
+@pytest.mark.parametrize("drift_knots", [None, np.array([0, 150, 300, 450, 667])])
+def test_a_segments_residual_and_fundamental_variances_are_those_of_dense_least_squares(
+        drift_knots):
+    """Segments of 613, 20, 14 and 12 samples for a fit of 3 harmonics (8 parameters): each
+    one's residual sum of squares over its samples less 8 and that times (X'X)^-1 of its
+    cos and sin of the fundamental (E|dX_1|^2 of white noise), against numpy's dense lstsq
+    (1e-9 relative: round-off of the closed forms; the 12-sample segment's fit is far less
+    well conditioned). A segment of 8 samples has no degree of freedom left: NaN. With
+    drift knots the segments keep their own DC and trend, and their variances."""
+    rng = np.random.default_rng(3)
+    theta, n_harm = 2 * np.pi / 12.8, 3
+    x = rng.standard_normal(667) + 2 * np.cos(theta * np.arange(667) + 0.4)
+    edges = np.array([0, 613, 633, 647, 659, 667])
+    fit = fit_harmonics(x, x[::-1].copy(), theta, n_harm, edges, drift_knots=drift_knots)
+    for s in range(4):
+        i = np.arange(edges[s], edges[s + 1])
+        u = (i - i.mean()) / i.size
+        design = np.column_stack([np.ones(i.size), u]
+                                 + [np.cos(n * theta * i) for n in range(1, n_harm + 1)]
+                                 + [np.sin(n * theta * i) for n in range(1, n_harm + 1)])
+        coef, rss = np.linalg.lstsq(design, x[i], rcond=None)[:2]
+        variance = float(rss[0]) / (i.size - 2 * n_harm - 2)
+        inverse = np.linalg.inv(design.T @ design)
+        assert fit.residual_variance[0, s] == pytest.approx(variance, rel=1e-9)
+        assert fit.fundamental_variance[0, s] == pytest.approx(
+            variance * (inverse[2, 2] + inverse[2 + n_harm, 2 + n_harm]), rel=1e-9)
+    assert np.isnan(fit.residual_variance[:, 4]).all()
+    assert np.isnan(fit.fundamental_variance[:, 4]).all()
+
+
 def test_spline_drift_fit_matches_dense_least_squares_and_keeps_the_segments():
     """``drift_knots``: the union's fit against numpy's lstsq with the explicit design matrix
     (harmonics and scipy's cubic B-splines on the same knots, clamped), on noise with a slow

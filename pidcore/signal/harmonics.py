@@ -205,12 +205,19 @@ class HarmonicFit:
     ``phasors[c, s, n-1]`` is the complex amplitude X_n of channel c in segment s, with
     x(t_i) ~ dc + sum_n Re(X_n exp(j n theta i)); ``total[c, n-1]`` the same fitted over all
     segments at once; ``dc_total`` likewise for the constant term (with ``drift_knots``, the
-    mean of the drift spline).
+    mean of the drift spline). ``residual_variance[c, s]`` is segment s's residual sum of
+    squares over its degrees of freedom (its samples less the fit's 2H + 2 parameters; NaN
+    where none are left), and ``fundamental_variance[c, s]`` the variance ``E|dX_1|^2`` that
+    white noise of that variance gives its fundamental, ``residual_variance x (G^-1_cos +
+    G^-1_sin)``: a segment hardly longer than the fit's parameters multiplies it far beyond
+    the ``4 s^2 / L`` of a long one.
     """
 
     phasors: np.ndarray
     total: np.ndarray
     dc_total: np.ndarray
+    residual_variance: np.ndarray
+    fundamental_variance: np.ndarray
 
 
 def _solve(g: np.ndarray, re: np.ndarray, im: np.ndarray, trend: float,
@@ -221,6 +228,27 @@ def _solve(g: np.ndarray, re: np.ndarray, im: np.ndarray, trend: float,
     a = c[2:n_harm + 2]
     b = c[n_harm + 2:]
     return c[0], a - 1j * b  # x = a cos - ... : Re(X e^{j.}) = Re X cos - Im X sin
+
+
+def _segment_noise(g: np.ndarray, re: np.ndarray, im: np.ndarray, trend: float, n_harm: int,
+                   sum_sq: float) -> tuple[float, float]:
+    """Residual variance of a segment's fit and the variance of its fundamental phasor (see
+    :class:`HarmonicFit`), from its Gram matrix, projections and ``sum x^2``: the residual's
+    sum of squares is ``sum x^2 - c'r`` (``G c = r``), without a pass over the samples."""
+    dof = int(round(g[0, 0])) - g.shape[0]
+    if dof <= 0:
+        return math.nan, math.nan
+    rhs = np.concatenate(([re[0], trend], re[1:], -im[1:]))
+    g_inv = np.linalg.inv(g)
+    variance = max(sum_sq - float(rhs @ g_inv @ rhs), 0.0) / dof
+    return variance, variance * float(g_inv[2, 2] + g_inv[n_harm + 2, n_harm + 2])
+
+
+def _sums_of_squares(data: list[np.ndarray], edges: np.ndarray) -> np.ndarray:
+    """``sum x^2`` of every channel in every segment (a dot product each: no temporary the
+    size of the record)."""
+    bounds = list(zip(edges[:-1], edges[1:], strict=True))
+    return np.array([[float(np.dot(x[a:b], x[a:b])) for a, b in bounds] for x in data])
 
 
 def _piece_blocks(theta: float, length: int, n_harm: int) -> tuple[np.ndarray, np.ndarray]:
@@ -288,6 +316,8 @@ def fit_harmonics(x: np.ndarray, y: np.ndarray | None, theta: float, n_harm: int
     n_ch, n_seg = re.shape[0], re.shape[1]
     lengths = np.diff(edges).astype(np.float64)
     phasors = np.zeros((n_ch, n_seg, n_harm), dtype=complex)
+    noise = np.full((2, n_ch, n_seg), np.nan)
+    sum_sq = _sums_of_squares([x, y] if use_y else [x], edges)
     for s in range(n_seg):
         length = int(lengths[s])
         if length < 2 * n_harm + 2:
@@ -298,6 +328,8 @@ def fit_harmonics(x: np.ndarray, y: np.ndarray | None, theta: float, n_harm: int
             # sum x u with u = (k - (L-1)/2)/L from sum x k and sum x
             trend = (tk[c, s] - 0.5 * (length - 1) * re[c, s, 0]) / length
             phasors[c, s] = _solve(g, re[c, s], im[c, s], trend, n_harm)[1]
+            noise[:, c, s] = _segment_noise(g, re[c, s], im[c, s], trend, n_harm,
+                                            sum_sq[c, s])
     total_length = int(edges[-1] - edges[0])
     g_all = _gram(theta, int(edges[0]), total_length, n_harm)
     total = np.zeros((n_ch, n_harm), dtype=complex)
@@ -307,7 +339,8 @@ def fit_harmonics(x: np.ndarray, y: np.ndarray | None, theta: float, n_harm: int
     for c in range(n_ch):
         trend = float(np.sum(tk[c] + offsets * re[c, :, 0])) / total_length
         dc[c], total[c] = _solve(g_all, re[c].sum(axis=0), im[c].sum(axis=0), trend, n_harm)
-    return HarmonicFit(phasors=phasors, total=total, dc_total=dc)
+    return HarmonicFit(phasors=phasors, total=total, dc_total=dc, residual_variance=noise[0],
+                       fundamental_variance=noise[1])
 
 
 def _spline_pieces(knots: np.ndarray) -> np.ndarray:
@@ -363,7 +396,8 @@ def _fit_spline_drift(x: np.ndarray, y: np.ndarray | None, theta: float, n_harm:
     re, im, tk, moments = _project_segments(x, y if use_y else x, use_y, float(theta),
                                             int(n_harm), parts, True)
     n_ch = re.shape[0]
-    phasors = _segment_phasors(re, im, tk, parts, edges, theta, n_harm)
+    phasors, noise = _segment_phasors(re, im, tk, parts, edges, theta, n_harm,
+                                      _sums_of_squares([x, y] if use_y else [x], edges))
 
     n_pieces = len(knots) - 1
     part_len = np.diff(parts).astype(np.float64)
@@ -420,16 +454,21 @@ def _fit_spline_drift(x: np.ndarray, y: np.ndarray | None, theta: float, n_harm:
         total[c] = solution[:n_harm] - 1j * solution[n_harm:]
         drift = cho_solve_banded((nn_factor, False), nx - nh @ solution)
         dc[c] = float(spline_sums @ drift) / float(knots[-1] - knots[0])
-    return HarmonicFit(phasors=phasors, total=total, dc_total=dc)
+    return HarmonicFit(phasors=phasors, total=total, dc_total=dc, residual_variance=noise[0],
+                       fundamental_variance=noise[1])
 
 
 def _segment_phasors(re: np.ndarray, im: np.ndarray, tk: np.ndarray, parts: np.ndarray,
-                     edges: np.ndarray, theta: float, n_harm: int) -> np.ndarray:
+                     edges: np.ndarray, theta: float, n_harm: int,
+                     sum_sq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Phasors of every segment of ``edges`` (DC, trend and harmonics each) from the
-    projections of the parts it is made of."""
+    projections of the parts it is made of, and their residual and fundamental variances
+    (:class:`HarmonicFit`; ``sum_sq``: the segments' ``sum x^2``), shape (2, channels,
+    segments)."""
     first = np.searchsorted(parts, edges)
     n_ch, n_seg = re.shape[0], len(edges) - 1
     phasors = np.zeros((n_ch, n_seg, n_harm), dtype=complex)
+    noise = np.full((2, n_ch, n_seg), np.nan)
     for s in range(n_seg):
         a, b = first[s], first[s + 1]
         length = int(edges[s + 1] - edges[s])
@@ -442,5 +481,7 @@ def _segment_phasors(re: np.ndarray, im: np.ndarray, tk: np.ndarray, parts: np.n
             seg_re = re[c, a:b].sum(axis=0)
             index_sum = float(np.sum(tk[c, a:b] + offsets * re[c, a:b, 0]))
             trend = (index_sum - 0.5 * (length - 1) * seg_re[0]) / length
-            phasors[c, s] = _solve(g, seg_re, im[c, a:b].sum(axis=0), trend, n_harm)[1]
-    return phasors
+            seg_im = im[c, a:b].sum(axis=0)
+            phasors[c, s] = _solve(g, seg_re, seg_im, trend, n_harm)[1]
+            noise[:, c, s] = _segment_noise(g, seg_re, seg_im, trend, n_harm, sum_sq[c, s])
+    return phasors, noise

@@ -78,7 +78,7 @@ from ..loop import ForceDisplacementLoop
 from ..records import Channel
 from . import validate
 from .frequency import estimate_drive_frequency, refine_frequency
-from .harmonics import fit_harmonics
+from .harmonics import HarmonicFit, fit_harmonics
 
 
 @dataclass(frozen=True)
@@ -501,21 +501,22 @@ def _check_acceleration_sign(acceleration_phasor: complex, velocity_phasor: comp
         "inverted channel (or the vibrometer delay is far from corrected)")
 
 
-def _check_stationary_drive(motion: np.ndarray, block_phasors: np.ndarray, edges: np.ndarray,
-                            sample_rate_hz: float, frequency_hz: float, *, what: str) -> str:
+def _check_stationary_drive(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
+                            motion: np.ndarray, sample_rate_hz: float, frequency_hz: float, *,
+                            what: str) -> str:
     """Refuse a drive whose frequency moves over the record (a slow sweep, a controller hunting),
     or return a note where it moves less but beyond noise ("" where it does not).
 
     The phasors of the record are one fit at one frequency; a drive line whose phase moves
     between the blocks adds up incoherently in it, so the acceleration and the energy per
     cycle came out low without a word (a 0.3 % sweep over 2 s at 500 Hz: 23 % and 40 % low),
-    and a faster sweep was refused as a purely resistive load. ``block_phasors`` (blocks,
-    harmonics) are the motion channel's in the blocks of the standard error: the loss is
-    ``1 - |mean of the fundamentals| / mean of their amplitudes``, which an amplitude change
-    alone (a beat) leaves at 0. Noise makes some: a block of L samples with residual variance
-    s^2 scatters its phasor by ``4 s^2 / L`` relative to |V_1|^2, and the loss is about a
-    quarter of that; the residual is each block's variance less its harmonics' power."""
-    fundamentals = block_phasors[:, 0]
+    and a faster sweep was refused as a purely resistive load. The motion channel's
+    fundamentals in the ``n_blocks`` blocks of the standard error (channel 1 of ``fit``) give
+    the loss ``1 - |mean of the fundamentals| / mean of their amplitudes``, which an amplitude
+    change alone (a beat) leaves at 0. Noise makes some: about a quarter of the blocks'
+    relative phasor variance ``E|dV_1|^2 / |V_1|^2``, which the fit gives from each block's
+    residual over its degrees of freedom (:class:`~pidcore.signal.harmonics.HarmonicFit`)."""
+    fundamentals = fit.phasors[1, :n_blocks, 0]
     amplitudes = np.abs(fundamentals)
     if fundamentals.size < 2 or not np.all(amplitudes > 0):
         return ""
@@ -523,20 +524,29 @@ def _check_stationary_drive(motion: np.ndarray, block_phasors: np.ndarray, edges
     loss = 1.0 - float(abs(np.mean(fundamentals))) / mean_amplitude
     if loss <= defaults.DRIVE_COHERENCE_NOTED_LOSS:
         return ""
-    scatter = []
-    for b in range(fundamentals.size):
-        block = motion[edges[b]:edges[b + 1]]
-        residual = float(np.var(block)) - 0.5 * float(np.sum(np.abs(block_phasors[b]) ** 2))
-        scatter.append(4 * max(residual, 0.0) / (block.size * amplitudes[b] ** 2))
+    n_params = 2 * fit.phasors.shape[2] + 2
+    # a block a few samples longer than the fit's parameters has no noise estimate to judge
+    # its phase by (one period of 12.8 samples at 12 parameters leaves under 1 degree of
+    # freedom, and the near-saturated fit multiplies its noise): a steady drive at 20 dB was
+    # refused as a sweep there half the time; the check says nothing
+    if int(np.min(np.diff(edges[:n_blocks + 1]))) - n_params < defaults.DRIVE_PHASE_MIN_DOF:
+        return ""
+    scatter = fit.fundamental_variance[1, :n_blocks] / amplitudes ** 2
     # the median: a block the drive has left (a fast sweep) holds its power in its residual
     if loss <= defaults.DRIVE_PHASE_NOISE_FACTOR * float(np.median(scatter)):
         return ""
-    first, last = (refine_frequency(motion[edges[i]:edges[i + 1]], sample_rate_hz, frequency_hz)
-                   for i in (0, fundamentals.size - 1))
-    said = (f"the drive line's phase moves between the {fundamentals.size} blocks of the record "
-            f"(from {first:.6g} Hz in the first to {last:.6g} Hz in the last), which takes "
-            f"{100 * loss:.3g} % or more off the fitted amplitude at {frequency_hz:.6g} Hz and "
-            "twice that off the energy per cycle (the loss factor, a ratio, keeps)")
+    phases = np.degrees(np.angle(fundamentals * np.conj(np.mean(fundamentals))))
+    moved = (f"the drive line's phase spans {np.ptp(phases):.3g} degrees over the "
+             f"{fundamentals.size} blocks of the record")
+    # a block's own frequency is known where it holds as many periods as a record must
+    block_periods = (edges[1] - edges[0]) * frequency_hz / sample_rate_hz
+    if block_periods >= defaults.MIN_PERIODS:
+        first, last = (refine_frequency(motion[edges[i]:edges[i + 1]], sample_rate_hz,
+                                        frequency_hz) for i in (0, fundamentals.size - 1))
+        moved += f" (from {first:.6g} Hz in the first to {last:.6g} Hz in the last)"
+    said = (f"{moved}, which takes {100 * loss:.3g} % or more off the fitted amplitude at "
+            f"{frequency_hz:.6g} Hz and twice that off the energy per cycle (the loss factor, "
+            "a ratio, keeps)")
     if loss <= defaults.DRIVE_COHERENCE_MAX_LOSS:
         return f"drive frequency not quite stationary: {said}"
     raise SignalError(
@@ -752,8 +762,8 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                       f"{defaults.DRIFT_KNOT_PERIODS}, so a slow wander that is not linear over "
                       "the record is not removed")
     fit = fit_harmonics(f_data, motion, theta, n_harm, edges, drift_knots=drift_knots)
-    stationary_note = (_check_stationary_drive(motion, fit.phasors[1, :k_blocks], edges,
-                                               sample_rate_hz, freq, what=what)
+    stationary_note = (_check_stationary_drive(fit, k_blocks, edges, motion, sample_rate_hz,
+                                               freq, what=what)
                        if k_blocks else "")
     a_fit = None
     if acc_data is not None and velocity is not None:
