@@ -41,8 +41,9 @@ N_UNCERTAINTY_BLOCKS = 8
 #: Largest loss of the drive line's amplitude, as a fraction, that a drive whose phase moves
 #: between the blocks of the standard error may cause before the record is refused as not
 #: stationary in frequency (1 - |mean of the blocks' phasors| / mean of their amplitudes): the
-#: fit of the record adds the blocks' phasors, so the acceleration comes out that much low
-#: and the energy per cycle twice that (a 0.3 % sweep over 2 s at 500 Hz: 23 % and 40 %),
+#: fit of the record adds the blocks' phasors, so a sweep's acceleration comes out that much
+#: low and the energy per cycle twice that (a 0.3 % sweep over 2 s at 500 Hz: 23 % and 40 %;
+#: a two-tone beat's can come out high, so the message says only what was measured),
 #: while the loss factor, a ratio, stays right. 2 % keeps the acceleration well inside the 5 %
 #: a load case is matched by; the one real long record among the fixtures (69.5 s at 182 Hz,
 #: whose generator's phase wanders) loses 1.6 %, analysed with a note

@@ -544,9 +544,12 @@ def _check_stationary_drive(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
         first, last = (refine_frequency(motion[edges[i]:edges[i + 1]], sample_rate_hz,
                                         frequency_hz) for i in (0, fundamentals.size - 1))
         moved += f" (from {first:.6g} Hz in the first to {last:.6g} Hz in the last)"
-    said = (f"{moved}, which takes {100 * loss:.3g} % or more off the fitted amplitude at "
-            f"{frequency_hz:.6g} Hz and twice that off the energy per cycle (the loss factor, "
-            "a ratio, keeps)")
+    # what was measured, not a loss against the truth: a sweep's result is that much low (or
+    # more), but a two-tone beat's (500 and 500.7 Hz) came out 2 % above its stronger tone
+    said = (f"{moved}: the drive is not one steady sine, and the record's fit at "
+            f"{frequency_hz:.6g} Hz, which adds the blocks' phasors, has {100 * loss:.3g} % "
+            "less amplitude than they have on average; its acceleration and energy per cycle "
+            "are those of that sum (the loss factor, a ratio, keeps)")
     if loss <= defaults.DRIVE_COHERENCE_MAX_LOSS:
         return f"drive frequency not quite stationary: {said}"
     raise SignalError(
