@@ -239,20 +239,15 @@ def test_a_static_friction_raised_to_a_pairs_sliding_friction_is_stated_as_run()
         [["static_friction", 0.5]]
 
 
-def test_a_variant_run_is_a_design_run_only_of_the_calibration_whose_design_made_it(
-        variants, tmp_path):
-    # a fit of observation parameters alone (no DEM design, no variant) at the same load case,
-    # cells and seed was named a dependent of every variant of its start: store list said
-    # "design run of" it, remove refused the runs for it and --with-dependents took it along
+def _two_calibrations(source, mine, result, tmp_path):
+    """A copy of the ``variants`` store with its rolling-friction design saved (``designed``)
+    beside a fit of ``baseline_loss_factor`` alone at the same load case, cells and seed
+    (``observed``, which runs the start file itself): (store, designed, observed, the
+    design's variant run keys, the store's runs, the start's run key)."""
     import shutil
 
-    import h5py
+    from pidcore.calibrate.persist import save_calibration
 
-    from pidcore.calibrate.persist import calibration_design_runs, save_calibration
-    from pidcore.errors import StoreError
-    from pidcore.store.manage import remove_records
-
-    source, mine, result = variants
     store = tmp_path / "dem.h5"
     shutil.copyfile(source, store)
     designed = save_calibration(result, store).key
@@ -266,6 +261,24 @@ def test_a_variant_run_is_a_design_run_only_of_the_calibration_whose_design_made
     runs = Store(store).list_dem_runs()
     start_key = next(k for k, sha in zip(runs["case_key"], runs["specimen_sha256"],
                                          strict=True) if sha == mine.hash)
+    return store, designed, observed, variant_keys, runs, start_key
+
+
+def test_a_variant_run_is_a_design_run_only_of_the_calibration_whose_design_made_it(
+        variants, tmp_path):
+    # a fit of observation parameters alone (no DEM design, no variant) at the same load case,
+    # cells and seed was named a dependent of every variant of its start: store list said
+    # "design run of" it, remove refused the runs for it and --with-dependents took it along
+
+    import h5py
+
+    from pidcore.calibrate.persist import calibration_design_runs
+    from pidcore.errors import StoreError
+    from pidcore.store.manage import remove_records
+
+    source, mine, result = variants
+    store, designed, observed, variant_keys, runs, start_key = _two_calibrations(
+        source, mine, result, tmp_path)
     # a variant of the same file another design made (another rolling friction): no run of
     # either calibration here
     other = Store(store).get_dem_run(variant_keys[0])
@@ -322,7 +335,6 @@ def test_a_run_of_the_start_is_a_design_run_only_of_a_calibration_whose_design_r
     # a design of variants alone (rolling frictions 0.25, 0.75: none the start's 0) claimed
     # another fit's run of the start at its load case, cells and seed: store remove named it
     # a dependent of that run, and verify took the run for its own when its variants were gone
-    import shutil
 
     import h5py
     import numpy as np
@@ -334,19 +346,8 @@ def test_a_run_of_the_start_is_a_design_run_only_of_a_calibration_whose_design_r
 
     source, mine, result = variants
     assert not is_design_start(mine, ["rolling_friction"], result.design.tolist())
-    store = tmp_path / "dem.h5"
-    shutil.copyfile(source, store)
-    designed = save_calibration(result, store).key
-    point = MeasuredPoint(CASE.frequency_hz, CASE.acceleration_g, CASE.fill_percent, 0.5,
-                          0.01, specimen="mycoupon", specimen_sha256=mine.hash)
-    observed = save_calibration(calibrate(
-        [point], fit=["baseline_loss_factor"], discrepancy=0.3, store_path=store,
-        cells=CONFIG.cells, steady_cycles=CONFIG.steady_cycles, dem_config=CONFIG,
-        workers=1, progress=False, specimen=mine), store).key
-    variant_keys = list(Store(source).list_dem_runs()["case_key"])
-    runs = Store(store).list_dem_runs()
-    start_key = next(k for k, sha in zip(runs["case_key"], runs["specimen_sha256"],
-                                         strict=True) if sha == mine.hash)
+    store, designed, observed, variant_keys, runs, start_key = _two_calibrations(
+        source, mine, result, tmp_path)
     assert calibration_design_runs(runs, [store], variants=True)[start_key] == (observed,)
     with pytest.raises(StoreError, match=f"DEM run {start_key} is a design run of "
                                          f"calibration {observed} \\(an input of its fit"):

@@ -180,7 +180,9 @@ def test_a_specimen_file_is_labelled_by_its_name_and_six_hex_digits_in_every_com
     assert main(["dem", "sweep", "--frequencies", "1000", "--accelerations", "5",
                  "--workers", "1", *common]) == 0
     out = capsys.readouterr().out
-    assert f"1 already in {store}" in out and out.rstrip().endswith(f"; specimen {label}")
+    # the summary line (the runs' own notes follow the case lines)
+    (summary,) = [line for line in out.splitlines() if f"1 already in {store}" in line]
+    assert summary.endswith(f"; specimen {label}")
     assert longer not in out
 
 
@@ -668,7 +670,8 @@ def test_a_sweeps_json_and_summary_name_each_runs_specimen_file(capsys, tmp_path
         assert main(args) == 0  # stored already: the summary names the stored run's file
         said[label] = capsys.readouterr().out
         assert f"1 already in {store}; wall time" in said[label]
-        assert said[label].rstrip().endswith(f"; specimen x [{spec.hash[:6]}]")
+        (summary,) = [line for line in said[label].splitlines() if " already in " in line]
+        assert summary.endswith(f"; specimen x [{spec.hash[:6]}]")
     assert first.hash != edited.hash
     assert len(Store(store).list_dem_runs()) == 2
 

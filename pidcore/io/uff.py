@@ -396,7 +396,9 @@ def _header_58(header: bytes) -> dict:
 
     from pyuff.datasets.dataset_58 import _extract58
 
-    if "header_only" not in inspect.signature(_extract58).parameters:
+    parameters = inspect.signature(_extract58).parameters
+    takes_keywords = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in parameters.values())
+    if "header_only" not in parameters and not takes_keywords:
         raise DependencyError(
             f"pyuff {getattr(pyuff, '__version__', '(version unknown)')} does not support "
             "reading a dataset 58 header alone (_extract58's header_only); pidcore needs "
