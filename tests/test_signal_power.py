@@ -674,6 +674,20 @@ def test_a_drive_sweeping_over_the_record_is_refused_not_reported_low(sweep, mov
     assert float(moved.split()[0]) == pytest.approx(500 * (1 - 7 / 16 * sweep), rel=1e-4)
 
 
+@pytest.mark.parametrize("sweep", [0.4, 0.8])
+def test_a_wide_sweep_is_refused_as_not_stationary_not_as_a_purely_resistive_load(sweep):
+    """A sweep over +-20 % (400-600 Hz) or +-40 % leaves the drive outside most blocks: their
+    residuals hold it, so the median block's noise excused the phases' disagreement, and the
+    blocks' phasors, added, left Im(P_c) within 3 standard errors of zero: refused as "a purely
+    resistive load", which sent the user to the velocity channel. The blocks' phases span a
+    turn and more, which a resistive load's steady drive does not; noise-free, the quietest
+    block's residual is the sweep within it, far below the 30 %+ loss."""
+    force, v, fs = _swept_record(sweep)
+    with pytest.raises(SignalError, match="drive frequency not stationary") as err:
+        analyze_power(force, v, fs, source="sweep")
+    assert "resistive" not in str(err.value)
+
+
 def test_a_drive_moving_less_is_analysed_with_a_note_of_what_it_takes_off():
     """A 0.05 % sweep over 2 s takes ~0.6 % off the fitted amplitude (under the 2 % refused,
     over the 0.1 % said): the result stands and says so, its acceleration that much low."""

@@ -503,7 +503,7 @@ def _check_acceleration_sign(acceleration_phasor: complex, velocity_phasor: comp
 
 def _check_stationary_drive(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
                             motion: np.ndarray, sample_rate_hz: float, frequency_hz: float, *,
-                            what: str) -> str:
+                            what: str, noise_of_quietest_block: bool = False) -> str:
     """Refuse a drive whose frequency moves over the record (a slow sweep, a controller hunting),
     or return a note where it moves less but beyond noise ("" where it does not).
 
@@ -515,7 +515,10 @@ def _check_stationary_drive(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
     the loss ``1 - |mean of the fundamentals| / mean of their amplitudes``, which an amplitude
     change alone (a beat) leaves at 0. Noise makes some: about a quarter of the blocks'
     relative phasor variance ``E|dV_1|^2 / |V_1|^2``, which the fit gives from each block's
-    residual over its degrees of freedom (:class:`~pidcore.signal.harmonics.HarmonicFit`)."""
+    residual over its degrees of freedom (:class:`~pidcore.signal.harmonics.HarmonicFit`).
+    ``noise_of_quietest_block`` judges noise by the quietest block, not the median one: where the
+    drive has left most blocks (a sweep over +-10 % and more) their residuals hold it, and the
+    median block's took the loss for noise."""
     fundamentals = fit.phasors[1, :n_blocks, 0]
     amplitudes = np.abs(fundamentals)
     if fundamentals.size < 2 or not np.all(amplitudes > 0):
@@ -533,7 +536,8 @@ def _check_stationary_drive(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
         return ""
     scatter = fit.fundamental_variance[1, :n_blocks] / amplitudes ** 2
     # the median: a block the drive has left (a fast sweep) holds its power in its residual
-    if loss <= defaults.DRIVE_PHASE_NOISE_FACTOR * float(np.median(scatter)):
+    noise = float(np.min(scatter) if noise_of_quietest_block else np.median(scatter))
+    if loss <= defaults.DRIVE_PHASE_NOISE_FACTOR * noise:
         return ""
     phases = np.degrees(np.angle(fundamentals * np.conj(np.mean(fundamentals))))
     moved = (f"the drive line's phase spans {np.ptp(phases):.3g} degrees over the "
@@ -787,7 +791,16 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
                                         None if a_fit is None else a_fit.phasors[0, :k_blocks],
                                         harmonics, omega, **kw)
     if require_mass_like:
-        _check_reactive_power_resolved(p_c, p_blocks, source=source)
+        try:
+            _check_reactive_power_resolved(p_c, p_blocks, source=source)
+        except SignalError:
+            # a wide sweep (400-600 Hz in 0.5 s) adds its blocks' phasors to about nothing, and
+            # was refused as a purely resistive load; its blocks' phases disagree, a resistive
+            # load's do not, so the drive is asked about before the load is blamed
+            if k_blocks:
+                _check_stationary_drive(fit, k_blocks, edges, motion, sample_rate_hz, freq,
+                                        what=what, noise_of_quietest_block=True)
+            raise
     if require_mass_like and not p_c.imag > 0:
         # There is no negative mass: a driven structure above its suspension resonance is
         # mass-like, Im(P_c) > 0. A negative reactive power is almost always one channel with
