@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import types
+from pathlib import Path
 
 import h5py
 import numpy as np
@@ -116,7 +117,7 @@ def test_a_store_of_several_calibrations_needs_a_key(calibrated, capsys, tmp_pat
     assert len(keys) == 2
     # the command it advises reads the new one (without the key it was refused: two stored)
     new_key = (set(keys) - {Store(store).list_calibrations()["key"].iloc[0]}).pop()
-    assert f"report --calibration {copy} --calibration-key {new_key})" in said
+    assert f"--calibration {copy} --calibration-key {new_key} --out report_out)" in said
     with pytest.raises(ParameterError, match="holds 2 calibrations; choose one with "
                                              "key=KEY") as refused:
         stored_calibration(copy)
@@ -150,9 +151,32 @@ def test_the_report_command_calibrate_prints_names_a_store_of_any_name_as_one_wo
     new_key = (set(Store(copy).list_calibrations()["key"])
                - {Store(store).list_calibrations()["key"].iloc[0]}).pop()
     (line,) = re.findall(r"\((pidcore report [^()]*)\)$", said, re.M)
-    # the shell's reading of the printed line is the command that reads the new calibration
-    assert shlex.split(line) == ["pidcore", "report", "--calibration", str(copy),
-                                 "--calibration-key", new_key]
+    # the shell's reading of the printed line is the command that reads the new calibration,
+    # of the DEM runs it was made from (--data's table is no report input)
+    assert shlex.split(line) == ["pidcore", "report", "--dem-store", str(copy),
+                                 "--calibration", str(copy), "--calibration-key", new_key,
+                                 "--out", "report_out"]
+
+
+def test_the_report_command_calibrate_prints_runs_as_pasted(calibrated, capsys, tmp_path):
+    """The printed next step had no --out, which report requires: pasted, it failed "the
+    following arguments are required: --out". Read by the real parser it is now a report of
+    the calibration's store (the measurements of --store and runs of --dem-store it used)."""
+    import shlex
+    from argparse import Namespace
+
+    from pidcore.cli import build_parser
+    from pidcore.cli.calibrate import _saved_words
+
+    store, runs, spec = tmp_path / "m s.h5", tmp_path / "runs.h5", tmp_path / "spec.toml"
+    said = _saved_words(("cal_0123456789abcdef", True),
+                        Namespace(store=store, dem_store=runs, specimen=spec))
+    line = said.split("(", 1)[1].removesuffix(")")
+    args = build_parser().parse_args(shlex.split(line)[1:])
+    assert (args.command, args.out, args.calibration, args.calibration_key) == \
+        ("report", Path("report_out"), runs, "cal_0123456789abcdef")
+    assert (args.store, args.dem_store, args.specimen, args.files) == \
+        (store, [runs], spec, [])
 
 
 def _calibration_columns(folder) -> pd.DataFrame:

@@ -154,7 +154,7 @@ def run(args: argparse.Namespace) -> int:
         saved = save_calibration(result, args.dem_store)
         # inside: a Ctrl-C as the result printed was answered by the generic line, which
         # said the complete --out "may hold part of this run's files"
-        _print_result(args, result, own_notes, _saved_words(saved, args.dem_store),
+        _print_result(args, result, own_notes, _saved_words(saved, args),
                       tally.specimens())
         interrupt.raise_if_interrupted()  # one swallowed on the way, or held by the move
     except BaseException as exc:  # noqa: BLE001 - an interrupt, or what one became in C code
@@ -162,7 +162,7 @@ def run(args: argparse.Namespace) -> int:
             raise
         # finished runs are each saved in their own transaction: counted from the store
         print(f"pidcore calibrate: interrupted; {tally.interrupted()}"
-              f"{_saved_words(saved, args.dem_store) if fitted else ''}"
+              f"{_saved_words(saved, args) if fitted else ''}"
               f"{_out_words(args.out, written)}",
               file=sys.stderr)
         interrupt.mark_handled()
@@ -210,17 +210,17 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
             print(f"wrote {args.out}")
 
 
-def _saved_words(saved, store: Path) -> str:
+def _saved_words(saved, args: argparse.Namespace) -> str:
     """What became of the calibration in the store (:func:`pidcore.calibrate.persist.
     save_calibration`'s :class:`~pidcore.calibrate.persist.SavedCalibration`; None: not
     saved)."""
+    store = args.dem_store
     if saved is None:
         return f"; the calibration was not saved in {store}"
     key, added = saved[0], saved[1]
     superseded = tuple(saved[2]) if len(saved) > 2 else ()
     if added:  # the key in the command: it still reads this one once the store holds more
-        then = command_line("pidcore", "report", "--calibration", store,
-                            "--calibration-key", key)
+        then = _report_command(args, key)
         words = f"; saved calibration {key} in {store} ({then})"
         if superseded:
             # "stored already" gave the earlier file: say that one is there, and why not it
@@ -228,6 +228,18 @@ def _saved_words(saved, store: Path) -> str:
                       "it was, this one saved beside it")
         return words
     return f"; calibration {key} is stored in {store} already (the same result)"
+
+
+def _report_command(args: argparse.Namespace, key: str) -> str:
+    """The ``pidcore report`` of this calibration, to paste: ``--out`` is required there (the
+    line without it failed "the following arguments are required: --out"), and the report
+    finds the measurements of --store and the DEM runs of --dem-store it was made from (--data's
+    table is no report input: the report is then of the DEM runs)."""
+    measured = ("--store", args.store) if args.store is not None else ()
+    specimen = ("--specimen", args.specimen) if args.specimen is not None else ()
+    return command_line("pidcore", "report", *measured, "--dem-store", args.dem_store,
+                        *specimen, "--calibration", args.dem_store, "--calibration-key", key,
+                        "--out", "report_out")
 
 
 def _store_points(points: list, specimen, store: Path, left_out: list[str]) -> list:
