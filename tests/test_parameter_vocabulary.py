@@ -168,12 +168,33 @@ def test_a_store_without_calibrations_names_the_keyword_or_the_command(tmp_path,
     assert main(["analyze", str(path), "--store", str(store)]) == 0
     capsys.readouterr()
     said = library_refusal(load_calibration, store)
-    assert said.endswith(f"(calibrate with store_path={store} to save one there, or give a "
-                         "calibration.json)")
+    assert said.endswith(f"(calibrate with store_path={str(store)!r} to save one there, or "
+                         "give a calibration.json)")
     err = cli_refusal(["report", "--out", str(tmp_path / "r"), "--store", str(store),
                        "--calibration", str(store)], capsys)
     assert f"(pidcore calibrate --dem-store {store} to save one there, or give a " \
         "calibration.json)" in err
+
+
+@pytest.mark.parametrize("name", ["c a l.h5", "it's $x.h5"])
+def test_the_calibrate_command_a_store_without_calibrations_names_pastes_as_its_path(
+        name, tmp_path, capsys):
+    """"c a l.h5" was said as "pidcore calibrate --dem-store c a l.h5" (three words to a shell):
+    the library's keyword value is a Python literal of the path, the command's the shell's."""
+    import shlex
+
+    from pidcore.calibrate import load_calibration
+
+    path = export(tmp_path / "rec_fill50.csv")
+    store = tmp_path / name
+    assert main(["analyze", str(path), "--store", str(store)]) == 0
+    capsys.readouterr()
+    said = library_refusal(load_calibration, store)
+    assert ast.literal_eval(said.split("store_path=")[1].split(" to save")[0]) == str(store)
+    err = cli_refusal(["report", "--out", str(tmp_path / "r"), "--calibration", str(store)],
+                      capsys)
+    line = err.split("(pidcore calibrate --dem-store ")[1].split(" to save one there")[0]
+    assert shlex.split(line) == [str(store)]
 
 
 def test_a_report_of_nothing_names_the_store_keywords_or_flags(tmp_path, capsys):

@@ -315,7 +315,7 @@ def stored_calibration(store_path: str | os.PathLike, key: str | None = None) ->
         return _calibration(store, key)
     if not keys:
         raise ParameterError(f"{path}: this store holds no calibration (calibrate "
-                             f"with store_path={path} to save one there, or give a "
+                             f"with store_path={str(path)!r} to save one there, or give a "
                              "calibration.json)")
     if len(keys) > 1:
         raise ParameterError(f"{path}: this store holds {len(keys)} calibrations; choose one "

@@ -9,11 +9,13 @@ sub-command in :data:`COMMAND_FLAGS` (``dem sweep`` takes ``--frequencies``).
 
 from __future__ import annotations
 
+import ast
 import functools
 import re
 from collections.abc import Iterable
 
 from ..errors import KEYWORD_NOT_AFTER_WORD, KEYWORD_NOT_BEFORE, outside_user_names
+from ._options import command_line
 
 #: Library keyword (as the message writes it) -> the flag of ``pidcore analyze`` and
 #: ``pidcore report`` that sets it: the analysis options and the load case. A single word
@@ -121,6 +123,13 @@ COMMAND_FLAGS["dem sweep"] = {
 }
 
 
+#: A command line the table says (its value the library's keyword's, a Python string literal:
+#: ``store_path='c a l.h5'``) with that value as the shell reads it (:func:`command_line`): the
+#: path was substituted raw, and "c a l.h5" pasted as three words
+_COMMAND_VALUE = re.compile(r"(pidcore calibrate --dem-store )"
+                            r"('(?:[^'\\\n]|\\.)*'|\"(?:[^\"\\\n]|\\.)*\")")
+
+
 @functools.cache
 def _table(command: str) -> tuple[dict[str, str], re.Pattern]:
     flags = COMMAND_FLAGS.get(command, {})
@@ -152,5 +161,7 @@ def cli_words(message: str, command: str = "analyze", *, names: Iterable[str] = 
     names in it (files, folders, channels, specimens, store keys, and ``names``: what the
     command line gave) stay as written."""
     flags, pattern = _table(command)
-    return outside_user_names(message, lambda text: pattern.sub(lambda m: _flag(flags, m), text),
+    said = outside_user_names(message, lambda text: pattern.sub(lambda m: _flag(flags, m), text),
                               names=names)
+    return _COMMAND_VALUE.sub(
+        lambda m: m.group(1) + command_line(ast.literal_eval(m.group(2))), said)
