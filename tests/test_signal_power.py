@@ -686,6 +686,14 @@ def test_a_wide_sweep_is_refused_as_not_stationary_not_as_a_purely_resistive_loa
     with pytest.raises(SignalError, match="drive frequency not stationary") as err:
         analyze_power(force, v, fs, source="sweep")
     assert "resistive" not in str(err.value)
+    # the first and last blocks' own lines, each inside the eighth of the sweep its block
+    # spans: refined from the record's 500 Hz, the first block of a 300-700 Hz sweep was
+    # quoted at 597.9 Hz
+    said = str(err.value).split(" Hz in the first to ")
+    first, last = float(said[0].rsplit("from ", 1)[1]), float(said[1].split(" Hz")[0])
+    low, high = 500 * (1 - sweep / 2), 500 * (1 + sweep / 2)
+    assert low <= first <= low + (high - low) / 8
+    assert high - (high - low) / 8 <= last <= high
 
 
 def test_a_drive_moving_less_is_analysed_with_a_note_of_what_it_takes_off():
