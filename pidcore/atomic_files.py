@@ -254,6 +254,9 @@ def check_folder_can_be_made(target: str | os.PathLike[str], *, label: str = "")
     from .errors import ParameterError
 
     place = Path(target).absolute()
+    if place.parent == place:  # no name to build beside: temporary_folder_path_for has none
+        raise ParameterError(f"{label or target}: is the file system's root, beside which no "
+                             "folder can be built; expected an output folder under it")
     while not place.parent.exists() and place.parent != place:
         place = place.parent
     probe = temporary_folder_path_for(place)

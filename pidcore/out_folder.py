@@ -130,6 +130,13 @@ def _not_its_own(out: Path, command: str) -> str:
     return ""
 
 
+def _in_use(real: Path) -> str:
+    """Why the folder ``real`` cannot be replaced whole whatever it holds ("" where it can)."""
+    if real.absolute().parent == real.absolute():  # nothing to build it beside nor rename
+        return "is the file system's root, which cannot be an output folder replaced whole"
+    return ""
+
+
 def check_replaceable(out: str | os.PathLike[str], command: str, *, option: str) -> None:
     """Refuse an output folder ``out`` that replacing whole with ``pidcore command``'s
     outputs would lose anything of (see the module's docstring), naming it, in ``option``'s
@@ -137,6 +144,10 @@ def check_replaceable(out: str | os.PathLike[str], command: str, *, option: str)
     unchanged outputs of the command's last run there, are taken."""
     out = Path(out)
     real = real_folder(out)
+    why = _in_use(real)
+    if why:
+        raise ParameterError(f"{option} {out}: {why}; choose a new or empty folder for "
+                             f"{option}")
     if not real.is_dir():
         return
     why = _not_its_own(real, command)

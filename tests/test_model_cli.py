@@ -990,3 +990,17 @@ def test_an_out_that_links_to_a_folder_keeps_the_link_and_its_folder_gets_the_ou
     assert link.is_symlink()
     assert sorted(p.name for p in real.iterdir()) == [RECORD_NAME, "equivalent_damper.json"]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["linkout", "realout"]
+
+
+@pytest.mark.parametrize("command", ["damper", "figures"])
+def test_the_file_systems_root_as_out_is_refused_in_one_line_directly_or_through_a_link(
+        tmp_path, capsys, command):
+    # `ln -sfn / lroot; model damper --out lroot` (or --out /) ended in a traceback: a
+    # ValueError for the build folder's name beside '/', which has none
+    (tmp_path / "lroot").symlink_to("/")
+    for out in ("/", str(tmp_path / "lroot")):
+        assert _run_main(["model", command, "--out", out]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "Traceback" not in err
+        assert f"--out {out}: is the file system's root" in err
+    assert (tmp_path / "lroot").readlink() == Path("/")

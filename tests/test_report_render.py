@@ -5,6 +5,7 @@ from __future__ import annotations
 import base64
 import re
 from datetime import UTC, datetime
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -615,6 +616,7 @@ def test_several_hidden_earlier_reports_are_refused_not_guessed_at(tmp_path):
 #: :func:`_build_leftovers.run_killed_at_rename`.
 _REPORT_SCRIPT = '''
 from datetime import UTC, datetime
+from pathlib import Path
 
 import pandas as pd
 
@@ -1067,3 +1069,22 @@ def test_report_says_once_which_characters_its_figures_could_not_draw(tmp_path, 
     if not installed_fallback_families():  # none where these tests run (fc-list :lang=zh)
         assert out.count("could not be drawn") == 1
         assert "note: 1 character(s) could not be drawn in the figures and PDF pages (鋼)" in out
+
+
+def test_the_file_systems_root_as_out_dir_is_refused_as_the_root_directly_or_through_a_link(
+        tmp_path, table, provenance, capsys):
+    # `report --out /` was refused as a folder holding no record, which moving files out of
+    # '/' would not make replaceable; through `ln -sfn / lroot` the same
+    from pidcore.cli import main
+
+    (tmp_path / "lroot").symlink_to("/")
+    for out in (Path("/"), tmp_path / "lroot"):
+        with pytest.raises(ParameterError) as refused:
+            write_report(table, {}, provenance, out, "csv")
+        assert str(refused.value) == (f"out_dir {out}: is the file system's root, which cannot "
+                                      "be an output folder replaced whole; choose a new or "
+                                      "empty folder for out_dir")
+        assert main(["report", "--store", str(tmp_path / "s.h5"), "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and "file system's root" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["lroot"]  # no store made either
