@@ -45,10 +45,11 @@ RECORD_NAME = ".pidcore-outputs.json"
 
 
 def real_folder(out: str | os.PathLike[str]) -> Path:
-    """The folder an ``--out`` names: where it is a link, the folder the link points to (every
-    link resolved), which is replaced while the link is kept; else ``out`` itself."""
-    out = Path(out)
-    return Path(os.path.realpath(out)) if out.is_symlink() else out
+    """The folder an ``--out`` names, as an absolute path with every link, ``.`` and ``..``
+    resolved: where it is a link, the folder the link points to, which is replaced while the
+    link is kept. ``--out .`` has no name to build a folder beside, and ``sub/..`` is the
+    current folder, which only its resolved path tells (:func:`check_replaceable`)."""
+    return Path(os.path.realpath(out))
 
 
 def _sha256(path: Path) -> str:
@@ -131,9 +132,18 @@ def _not_its_own(out: Path, command: str) -> str:
 
 
 def _in_use(real: Path) -> str:
-    """Why the folder ``real`` cannot be replaced whole whatever it holds ("" where it can)."""
-    if real.absolute().parent == real.absolute():  # nothing to build it beside nor rename
+    """Why the folder ``real`` (:func:`real_folder`'s) cannot be replaced whole whatever it
+    holds ("" where it can)."""
+    if real.parent == real:  # nothing to build it beside nor rename
         return "is the file system's root, which cannot be an output folder replaced whole"
+    try:
+        here = Path(os.getcwd())  # resolved, as real is
+    except OSError:  # the current folder was deleted: none to keep
+        return ""
+    if real == here or real in here.parents:
+        # the shell's folder would be the one deleted, and it left in a folder that is gone
+        return (f"is the current folder or holds it ({real}), which replacing whole would pull "
+                "out from under the shell")
     return ""
 
 

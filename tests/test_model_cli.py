@@ -1004,3 +1004,28 @@ def test_the_file_systems_root_as_out_is_refused_in_one_line_directly_or_through
         assert err.count("\n") == 1 and "Traceback" not in err
         assert f"--out {out}: is the file system's root" in err
     assert (tmp_path / "lroot").readlink() == Path("/")
+
+
+def test_an_out_that_is_the_current_folder_or_above_it_is_refused_before_any_work(
+        tmp_path, monkeypatch, capsys):
+    # `cd d1 && model damper --out .` ended in a traceback (PosixPath('.') has an empty
+    # name), and `--out "$PWD"` replaced the shell's folder, the shell left in a deleted one
+    here = tmp_path / "d1"
+    here.mkdir()
+    (here / "thesis.tex").write_text("mine")
+    monkeypatch.chdir(here)
+    grid = ["--fills", "50", "--accelerations", "5", "--frequencies", "100"]
+    for out in (".", str(here), "sub/../.", "..", str(tmp_path)):
+        assert _run_main(["model", "damper", "--out", out, "--format", "csv", *grid]) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1
+        assert f"--out {Path(out)}: is the current folder or holds it" in err
+    # an empty current folder too: what it holds is not the reason
+    (here / "thesis.tex").unlink()
+    assert _run_main(["model", "damper", "--out", ".", "--format", "csv", *grid]) == 2
+    assert "is the current folder" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d1"] and not any(here.iterdir())
+    # a folder below it, named through '..', is resolved and written as named
+    assert _run_main(["model", "damper", "--out", "../d1/./out", "--format", "csv", *grid]) == 0
+    assert sorted(p.name for p in (here / "out").iterdir()) == [RECORD_NAME,
+                                                                "equivalent_damper.csv"]

@@ -1088,3 +1088,27 @@ def test_the_file_systems_root_as_out_dir_is_refused_as_the_root_directly_or_thr
         err = capsys.readouterr().err
         assert err.count("\n") == 1 and "file system's root" in err
     assert sorted(p.name for p in tmp_path.iterdir()) == ["lroot"]  # no store made either
+
+
+def test_an_out_dir_that_is_the_current_folder_or_above_it_is_refused_before_any_analysis(
+        tmp_path, table, provenance, monkeypatch, capsys):
+    # `cd e4 && report ../x.csv --out .` analysed everything, then ended in a traceback
+    # (PosixPath('.') has an empty name); `--out "$PWD"` replaced the shell's own folder
+    import pidcore.report.pipeline as pipeline
+    from pidcore.cli import main
+
+    here = tmp_path / "e4"
+    here.mkdir()
+    monkeypatch.chdir(here)
+    for out in (Path("."), here, Path("..")):
+        with pytest.raises(ParameterError, match=r"is the current folder or holds it \("):
+            write_report(table, {}, provenance, out, "csv")
+
+    def analysed(*args, **kwargs):
+        raise AssertionError("analysed before the refusal")
+
+    monkeypatch.setattr(pipeline, "analyze_files", analysed)
+    assert main(["report", str(tmp_path / "x.csv"), "--out", "."]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "is the current folder or holds it" in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["e4"] and not any(here.iterdir())
