@@ -386,7 +386,8 @@ def _remove_folder_or_link(path: Path) -> None:
 
 
 def restore_previous_folder(target: str | os.PathLike[str], *,
-                            is_previous: Callable[[Path], bool] = lambda folder: True
+                            is_previous: Callable[[Path], bool] = lambda folder: True,
+                            why_kept: Callable[[Path], str] = lambda folder: ""
                             ) -> Path | None:
     """Settle what a killed :func:`replace_folder` left beside ``target``; returns the folder
     restored (None: none was). Call it before any other write of ``target``.
@@ -398,7 +399,9 @@ def restore_previous_folder(target: str | os.PathLike[str], *,
     itself, not a link, and that ``is_previous`` accepts (a report's marker) is taken, by
     the rule of the build folders' clean-up. Several beside a missing ``target`` are
     refused (a ``ParameterError`` naming them): which was the last is no longer certain,
-    and none is removed or guessed at. An existing ``target`` is never touched.
+    and none is removed or guessed at. An existing ``target`` is never touched. Nor is one to
+    be removed that ``why_kept`` says removing would lose something of (a file added to it
+    since): refused, naming it and why, none removed.
     """
     import shutil
 
@@ -413,6 +416,13 @@ def restore_previous_folder(target: str | os.PathLike[str], *,
     except OSError:  # no parent yet, or one that cannot be listed: nothing left there
         return None
     if os.path.lexists(target):
+        for entry in found:
+            why = why_kept(entry)
+            if why:
+                raise ParameterError(
+                    f"{entry}: left hidden beside {target.name} by a killed write, with its "
+                    f"earlier outputs, to be removed, but it {why}; move what you keep out of "
+                    "it, then remove it")
         for entry in found:
             shutil.rmtree(entry, ignore_errors=True)
         return None

@@ -147,6 +147,19 @@ def _in_use(real: Path) -> str:
     return ""
 
 
+def restore_previous(out: str | os.PathLike[str], command: str, *,
+                     is_previous: Callable[[Path], bool] | None = None) -> Path | None:
+    """:func:`pidcore.atomic_files.restore_previous_folder` for ``out`` (its link's folder):
+    the earlier outputs of ``pidcore command`` a killed swap left hidden beside it
+    (``is_previous``: which hidden folder is one, default one of this command's records) put
+    back, or removed where ``out`` exists, and then only where they hold the files their record
+    lists, unchanged (a user's file copied into one since is not deleted: refused, naming it).
+    Returns the folder restored, None if none was."""
+    return restore_previous_folder(
+        real_folder(out), is_previous=is_previous or (lambda folder: written_by(folder, command)),
+        why_kept=lambda folder: _not_its_own(folder, command))
+
+
 def check_replaceable(out: str | os.PathLike[str], command: str, *, option: str) -> None:
     """Refuse an output folder ``out`` that replacing whole with ``pidcore command``'s
     outputs would lose anything of (see the module's docstring), naming it, in ``option``'s
@@ -177,13 +190,10 @@ def write_folder_whole(out: str | os.PathLike[str], command: str,
     ``out`` is checked first (:func:`check_replaceable`); the folder built gets the record of
     its files (:data:`RECORD_NAME`) and, where given, the permissions ``mode``. A run killed
     while swapping (where the system cannot swap in one step) left the earlier folder hidden
-    beside it, which is put back first (:func:`pidcore.atomic_files.restore_previous_folder`;
-    ``is_previous``: which hidden folder is an earlier one, default one of this command's
-    records)."""
+    beside it, which is put back first (:func:`restore_previous`, ``is_previous`` its)."""
     out = Path(out)
     real = real_folder(out)
-    restore_previous_folder(  # first: a hidden one is the earlier
-        real, is_previous=is_previous or (lambda folder: written_by(folder, command)))
+    restore_previous(out, command, is_previous=is_previous)  # first: a hidden one is the earlier
     check_replaceable(out, command, option=option)
     real.parent.mkdir(parents=True, exist_ok=True)
     work = new_temporary_folder_for(real)

@@ -1029,3 +1029,30 @@ def test_an_out_that_is_the_current_folder_or_above_it_is_refused_before_any_wor
     assert _run_main(["model", "damper", "--out", "../d1/./out", "--format", "csv", *grid]) == 0
     assert sorted(p.name for p in (here / "out").iterdir()) == [RECORD_NAME,
                                                                 "equivalent_damper.csv"]
+
+
+def test_a_hidden_earlier_output_folder_holding_a_users_file_is_refused_not_removed(
+        tmp_path, capsys):
+    # a '.d.<hex>.old' folder with model damper's record was deleted beside an existing d
+    # whatever else it held: a user's thesis.tex copied into it went with it
+    grid = ["--fills", "50", "--accelerations", "5", "--frequencies", "100"]
+    hidden = tmp_path / ".d.0123456789abcdef.old"
+    for out in (tmp_path / "d", hidden):
+        assert _run_main(["model", "damper", "--out", str(out), "--format", "csv", *grid]) == 0
+    (hidden / "thesis.tex").write_text("mine")
+    capsys.readouterr()  # the two runs' notes
+    assert _run_main(["model", "damper", "--out", str(tmp_path / "d"), "--format", "json",
+                      *grid]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"{hidden}: left hidden beside d by a killed write" in err
+    assert "holds 'thesis.tex', which pidcore model damper did not write" in err
+    assert (hidden / "thesis.tex").read_text() == "mine"
+    assert sorted(p.name for p in (tmp_path / "d").iterdir()) == [RECORD_NAME,
+                                                                  "equivalent_damper.csv"]
+    # holding its record's files alone, it is removed as before and d replaced
+    (hidden / "thesis.tex").unlink()
+    assert _run_main(["model", "damper", "--out", str(tmp_path / "d"), "--format", "json",
+                      *grid]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d"]
+    assert sorted(p.name for p in (tmp_path / "d").iterdir()) == [RECORD_NAME,
+                                                                  "equivalent_damper.json"]

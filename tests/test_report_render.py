@@ -577,7 +577,8 @@ def test_only_a_hidden_earlier_report_of_the_exact_name_is_restored(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == [".rp.backup.old", "rp"]
 
 
-def test_a_hidden_earlier_report_beside_an_existing_one_is_removed_and_rp_untouched(tmp_path):
+def test_a_hidden_earlier_report_beside_an_existing_one_is_removed_and_rp_untouched(
+        tmp_path, table, provenance):
     # a write killed after the new report was in place, before the earlier one moved aside
     # was removed, left it hidden for ever (it was put back only where rp was missing); and
     # had rp been removed later, a report it had replaced came back in its place
@@ -586,11 +587,42 @@ def test_a_hidden_earlier_report_beside_an_existing_one_is_removed_and_rp_untouc
     (tmp_path / "rp").mkdir()
     (tmp_path / "rp" / REPORT_MARKER).write_text("the new one")
     for name in (".rp.0123456789abcdef.old", ".rp.backup.old"):  # the pattern; a user's
-        (tmp_path / name).mkdir()
-        (tmp_path / name / REPORT_MARKER).write_text("the earlier one")
+        write_report(table, {}, provenance, tmp_path / name, "csv")  # an earlier report
     assert restore_previous_report(tmp_path / "rp") is None
     assert sorted(p.name for p in tmp_path.iterdir()) == [".rp.backup.old", "rp"]
     assert (tmp_path / "rp" / REPORT_MARKER).read_text() == "the new one"
+
+
+def test_a_hidden_earlier_report_holding_a_users_file_is_refused_not_removed(
+        tmp_path, table, provenance):
+    # the hidden earlier report beside an existing rp was deleted for holding the marker,
+    # whatever else was in it: a user's thesis.tex copied there went with it
+    from pidcore.report.render import restore_previous_report
+
+    hidden = tmp_path / ".rp.0123456789abcdef.old"
+    write_report(table, {}, provenance, tmp_path / "rp", "csv")
+    write_report(table, {}, provenance, hidden, "csv")
+    (hidden / "thesis.tex").write_text("mine")
+    before = {p.relative_to(tmp_path): p.read_bytes() for p in tmp_path.rglob("*")
+              if p.is_file()}
+    with pytest.raises(ParameterError) as refused:
+        restore_previous_report(tmp_path / "rp")
+    assert str(refused.value) == (
+        f"{hidden}: left hidden beside rp by a killed write, with its earlier outputs, to be "
+        "removed, but it holds 'thesis.tex', which pidcore report did not write there and "
+        "replacing its earlier outputs whole would delete; move what you keep out of it, then "
+        "remove it")
+    # nothing removed, the report's write refused the same
+    with pytest.raises(ParameterError, match="thesis.tex"):
+        write_report(table.iloc[:1], {}, provenance, tmp_path / "rp", "csv")
+    assert {p.relative_to(tmp_path): p.read_bytes() for p in tmp_path.rglob("*")
+            if p.is_file()} == before
+    # a listed file changed since is kept the same way
+    (hidden / "thesis.tex").unlink()
+    (hidden / "report.csv").write_text("edited")
+    with pytest.raises(ParameterError, match="'report.csv' changed since"):
+        restore_previous_report(tmp_path / "rp")
+    assert (hidden / "report.csv").read_text() == "edited"
 
 
 def test_several_hidden_earlier_reports_are_refused_not_guessed_at(tmp_path):

@@ -26,10 +26,9 @@ from pathlib import Path
 import pandas as pd
 
 from .. import defaults
-from ..atomic_files import restore_previous_folder
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError
-from ..out_folder import check_replaceable, real_folder, write_folder_whole
+from ..out_folder import check_replaceable, restore_previous, write_folder_whole
 from ..units import value_and_error_texts
 from .provenance import Provenance
 from .table import (
@@ -752,7 +751,7 @@ def restore_previous_report(out_dir: str | Path) -> Path | None:
     folder left after the replacement had finished. Returns the folder restored, None if
     none was (:func:`restored_report_note` says so); a ``ParameterError`` where several are
     hidden beside a missing ``out_dir``. :func:`write_report` calls it first."""
-    return restore_previous_folder(real_folder(out_dir), is_previous=_is_report)
+    return restore_previous(out_dir, REPORT_COMMAND, is_previous=_is_report)
 
 
 def _is_report(folder: Path) -> bool:
