@@ -122,7 +122,7 @@ def temporary_name_pattern(target: str | os.PathLike[str]) -> re.Pattern[str]:
     """The names :func:`temporary_path_for` gives beside ``target``, and no others (a prefix
     match took the temporary file of a target named like this one plus a suffix, ``s.h5`` and
     ``s.h5.old.h5``)."""
-    return re.compile(re.escape(f".{Path(target).name}.") + r"[0-9a-f]{16}"
+    return re.compile(re.escape(f".{Path(os.path.abspath(target)).name}.") + r"[0-9a-f]{16}"
                       + re.escape(TEMPORARY_SUFFIX))
 
 
@@ -183,15 +183,17 @@ TEMPORARY_FOLDER_SUFFIX = ".tmpdir"
 
 def temporary_folder_path_for(target: str | os.PathLike[str]) -> Path:
     """A fresh hidden name beside the folder ``target`` (``.<name>.<16 hex>.tmpdir``), for a
-    folder of outputs built there and renamed into place (a report, a calibration's files)."""
-    target = Path(target)
+    folder of outputs built there and renamed into place (a report, a calibration's files).
+    ``.`` or ``..`` is taken as the folder it names (``calibrate --out .`` failed with "has
+    an empty name" after its DEM runs)."""
+    target = Path(os.path.abspath(target))
     return target.with_name(f".{target.name}.{secrets.token_hex(8)}{TEMPORARY_FOLDER_SUFFIX}")
 
 
 def temporary_folder_name_pattern(target: str | os.PathLike[str]) -> re.Pattern[str]:
     """The names :func:`temporary_folder_path_for` gives beside ``target``, and no others (a
     user's ``.<name>.backup`` is not one)."""
-    return re.compile(re.escape(f".{Path(target).name}.") + r"[0-9a-f]{16}"
+    return re.compile(re.escape(f".{Path(os.path.abspath(target)).name}.") + r"[0-9a-f]{16}"
                       + re.escape(TEMPORARY_FOLDER_SUFFIX))
 
 
@@ -447,7 +449,7 @@ COMMITTED_FOLDER_SUFFIX = ".commit"
 def committed_folder_name_pattern(target: str | os.PathLike[str]) -> re.Pattern[str]:
     """The names :func:`move_files_into_folder` gives its committed build folder beside
     ``target``, and no others."""
-    return re.compile(re.escape(f".{Path(target).name}.") + r"[0-9a-f]{16}"
+    return re.compile(re.escape(f".{Path(os.path.abspath(target)).name}.") + r"[0-9a-f]{16}"
                       + re.escape(COMMITTED_FOLDER_SUFFIX))
 
 

@@ -380,3 +380,17 @@ def test_a_folder_replacing_a_link_leaves_what_it_linked_and_nothing_beside(tmp_
         assert _only(linked) == ["report.csv"] and (linked / "report.csv").read_text() == "linked"
         (target / "report.csv").unlink()
         target.rmdir()
+
+
+def test_a_build_folder_for_dot_is_made_beside_the_folder_dot_names(tmp_path, monkeypatch):
+    # `calibrate --out .` built its files in Path(".").with_name(...): "PosixPath('.') has an
+    # empty name" after its DEM runs; "." and ".." are the folders they name
+    from pidcore.atomic_files import temporary_folder_name_pattern, temporary_folder_path_for
+
+    here = tmp_path / "work"
+    (here / "sub").mkdir(parents=True)
+    monkeypatch.chdir(here / "sub")
+    for given, named in ((".", here / "sub"), ("..", here), ("../sub/.", here / "sub")):
+        work = temporary_folder_path_for(given)
+        assert work.parent == named.parent
+        assert temporary_folder_name_pattern(given).fullmatch(work.name)
