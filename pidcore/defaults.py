@@ -67,6 +67,14 @@ DRIVE_PHASE_NOISE_FACTOR = 10.0
 #: loss noise makes in 2e-3 of records (a steady drive refused), with 2 in 6e-6, with 4 under
 #: 1e-6 (2 million draws of that model).
 DRIVE_PHASE_MIN_DOF = 4
+#: Widest angle, in degrees, of the complex power below the force's line (Re(P_c) > 0,
+#: Im(P_c) <= 0) at which a refusal of a negative reactive power says the motion channel may
+#: hold the wrong quantity. A motion channel holding the derivative of its quantity (an
+#: acceleration under "velocity", or an inverted displacement) turns P_c by 90 degrees, from
+#: 90 - d to -d, d = atan(loss factor): within 30 degrees for loss factors up to tan 30 = 0.58,
+#: beyond any particle damper's. An inverted channel turns P_c to -90 - d instead, which only a
+#: negative loss factor brings within 30 degrees of 0: the bound never takes an inversion for it.
+QUANTITY_SLIP_MAX_PHASE_DEG = 30.0
 #: Whole drive periods between the knots of the cubic spline that takes up the drift of a
 #: record: a slow wander (a shaker table at 0.3-1 Hz) is not a line over a 2 s record, and one
 #: trend over it leaked the rest into the harmonics (1e-4 of loss factor at 5 %); a spline

@@ -168,6 +168,34 @@ def test_spring_like_or_inverted_record_is_refused():
         analyze_power(rec.force_n, -rec.velocity_m_s, fs)
 
 
+def test_a_motion_channel_holding_the_wrong_quantity_is_named_and_an_inversion_is_not():
+    """An acceleration under the velocity's name (F = m a + c v read against a) puts P_c near
+    the force's line, at -atan(eta) = -2.9 degrees for eta 0.05, 90 degrees from a mass's
+    P_c: it was refused as "probably inverted", and --invert only moved the refusal. It now
+    names the channel and the quantity it probably holds; an inverted velocity (P_c at -92.9
+    degrees) keeps the inverted-channel refusal word for word."""
+    fs, f, m = 10240.0, 100.0, 0.5
+    c = 0.05 * m * 2 * np.pi * f  # loss factor 0.05
+    rec = synthesize_shaker_record(mass_kg=m, acceleration_amplitude_m_s2=20.0, frequency_hz=f,
+                                   sample_rate_hz=fs, n_periods=40, viscous_damping_n_s_m=c,
+                                   with_acceleration=True)
+    slip = ("channel 'V', read as a velocity in m/s, probably holds an acceleration (m/s²), "
+            "or a displacement (m) of the other sign")
+    inverted = ("one of the channels 'F' / 'V' is probably inverted: check the sensor "
+                "directions, or pass invert=NAME for the inverted channel")
+    with pytest.raises(SignalError) as slipped:
+        analyze_power(rec.force_n, rec.acceleration_m_s2, fs, force_name="F", velocity_name="V")
+    assert slip in str(slipped.value) and "3° apart" in str(slipped.value)
+    with pytest.raises(SignalError) as flipped:
+        analyze_power(rec.force_n, -rec.velocity_m_s, fs, force_name="F", velocity_name="V")
+    assert str(flipped.value).endswith(f"> 0); {inverted}")
+    # the acceleration-only path: a velocity of the other sign under the acceleration's name
+    with pytest.raises(SignalError, match=r"channel 'A', read as an acceleration in m/s², "
+                                          r"probably holds a velocity \(m/s\) of the other"):
+        analyze_power(rec.force_n, None, fs, acceleration=-rec.velocity_m_s,
+                      force_name="F", velocity_name="A")
+
+
 def test_acceleration_only_path():
     fs, f, m, c, fc = 25600.0, 400.0, 0.3, 6.0, 0.4
     rec = synthesize_shaker_record(mass_kg=m, acceleration_amplitude_m_s2=5 * G, frequency_hz=f,

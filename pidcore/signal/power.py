@@ -501,6 +501,24 @@ def _check_acceleration_sign(acceleration_phasor: complex, velocity_phasor: comp
         "inverted channel (or the vibrometer delay is far from corrected)")
 
 
+def _quantity_slip_cause(p_c: complex, motion_name: str, *, motion_is_velocity: bool) -> str:
+    """The likely cause of a negative reactive power whose P_c lies near the force's line: the
+    motion channel holds its quantity's derivative (an acceleration in the velocity column),
+    which turns P_c by 90 degrees, where an inversion turns it by 180
+    (:data:`~pidcore.defaults.QUANTITY_SLIP_MAX_PHASE_DEG`); "" elsewhere."""
+    phase = math.degrees(math.atan2(p_c.imag, p_c.real))
+    if not (p_c.real > 0 and -defaults.QUANTITY_SLIP_MAX_PHASE_DEG <= phase <= 0):
+        return ""
+    # the slips that land there: the derivative, or the integral with the other sign
+    expected, slips = (("a velocity in m/s",
+                        "an acceleration (m/s²), or a displacement (m) of the other sign")
+                       if motion_is_velocity else
+                       ("an acceleration in m/s²", "a velocity (m/s) of the other sign"))
+    return (f"force and motion are {abs(phase):.0f}° apart, near in phase, where a mass gives "
+            f"about 90° and an inverted channel about -90°: channel {motion_name!r}, read as "
+            f"{expected}, probably holds {slips} (check the column's quantity and unit)")
+
+
 def _check_stationary_drive(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
                             motion: np.ndarray, sample_rate_hz: float, frequency_hz: float, *,
                             what: str, noise_of_quietest_block: bool = False) -> str:
@@ -817,6 +835,9 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         # subtracted inertia force then exceeds the structure's.
         cause = (f"one of the channels {force_name!r} / {motion_name!r} {PROBABLY_INVERTED}: "
                  "check the sensor directions, or pass invert=NAME for the inverted channel")
+        slip = _quantity_slip_cause(p_c, motion_name, motion_is_velocity=velocity is not None)
+        if slip:
+            cause = f"{slip}; else {cause}"
         if mass_below_gauge_kg > 0:
             cause = (f"mass_below_gauge_kg {mass_below_gauge_kg:g} kg is probably larger than "
                      "the mass between gauge and structure (its cancelled inertia exceeds the "
