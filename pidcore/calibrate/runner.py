@@ -134,20 +134,16 @@ def is_design_variant(stated: Sequence[tuple[str, float]], names: Sequence[str],
 
     Both are the design's floats through JSON, compared exactly: any other variant of the same
     file (another calibration's design) is not this calibration's run."""
+    if not names:
+        return False
     wanted = [(str(name), float(value)) for name, value in stated]
-    for point in points:
-        if len(point) != len(names) or not names:
-            continue
-        values = {str(n): float(v) for n, v in zip(names, point, strict=True)}
+    for values in _design_values(names, points):
         if list(values.items()) == wanted:
             return True
         # stated per pair as run: the same statement and the point setting nothing anew
-        if variant is not None and _values_as_set(variant, values) == wanted:
-            try:
-                if specimen_with(variant, values).hash == variant.hash:
-                    return True
-            except ParameterError:
-                continue  # a point outside the variant's domain did not make it
+        if variant is not None and _values_as_set(variant, values) == wanted \
+                and _leaves_unchanged(variant, values):
+            return True
     return False
 
 
@@ -161,16 +157,23 @@ def is_design_start(start: Specimen, names: Sequence[str],
 
     The design's floats through JSON are the ones the runner set, so a point rebuilds its
     specimen exactly."""
-    for point in points:
-        if len(point) != len(names):
-            continue
-        values = {str(n): float(v) for n, v in zip(names, point, strict=True)}
-        try:
-            if specimen_with(start, values).hash == start.hash:
-                return True
-        except ParameterError:
-            continue  # a point outside the file's domain did not make it
-    return False
+    return any(_leaves_unchanged(start, values) for values in _design_values(names, points))
+
+
+def _design_values(names: Sequence[str],
+                   points: Sequence[Sequence[float]]) -> list[dict[str, float]]:
+    """The values each design point of ``names`` sets, by name (a point of another length,
+    which no design of these names made, left out)."""
+    return [{str(n): float(v) for n, v in zip(names, point, strict=True)}
+            for point in points if len(point) == len(names)]
+
+
+def _leaves_unchanged(specimen: Specimen, values: dict[str, float]) -> bool:
+    """Whether setting ``values`` on ``specimen`` (:func:`specimen_with`) gives it back."""
+    try:
+        return specimen_with(specimen, values).hash == specimen.hash
+    except ParameterError:
+        return False  # a point outside the specimen's domain did not make it
 
 
 def run_requests(requests: Sequence[RunRequest], *, store_path: str | os.PathLike,
