@@ -118,14 +118,6 @@ def longest_name_with_a_temporary(target: str | os.PathLike[str]) -> int:
     return name_max - added
 
 
-def temporary_name_pattern(target: str | os.PathLike[str]) -> re.Pattern[str]:
-    """The names :func:`temporary_path_for` gives beside ``target``, and no others (a prefix
-    match took the temporary file of a target named like this one plus a suffix, ``s.h5`` and
-    ``s.h5.old.h5``)."""
-    return re.compile(re.escape(f".{Path(os.path.abspath(target)).name}.") + r"[0-9a-f]{16}"
-                      + re.escape(TEMPORARY_SUFFIX))
-
-
 #: Any name :func:`temporary_path_for` gives, its target's name as ``target``: the hex part
 #: and suffix are fixed, so the target is whatever stands before them.
 _TEMPORARY_NAME = re.compile(r"\.(?P<target>.+)\.[0-9a-f]{16}" + re.escape(TEMPORARY_SUFFIX))
