@@ -140,6 +140,12 @@ def _project_segments(x, y, use_y, theta, n_harm, edges,
     return out_re, out_im, out_t, out_d
 
 
+def fit_parameter_count(n_harm: int) -> int:
+    """The parameters of one segment's fit: DC, trend and each harmonic's cosine and sine
+    (2H + 2); a segment of fewer samples has no phasors (NaN)."""
+    return 2 * n_harm + 2
+
+
 def _geometric_sums(theta: float, start: int, length: int, m_max: int) -> np.ndarray:
     """``S(m) = sum_{i=start}^{start+length-1} exp(j m theta i)`` for m = 0..m_max (closed form)."""
     m = np.arange(m_max + 1)
@@ -178,7 +184,7 @@ def _gram(theta: float, start: int, length: int, n_harm: int) -> np.ndarray:
     def sm(k: int) -> complex:  # S(-k) = conj(S(k))
         return s[k] if k >= 0 else np.conj(s[-k])
 
-    size = 2 * n_harm + 2
+    size = fit_parameter_count(n_harm)
     g = np.empty((size, size))
     g[0, 0] = length
     g[0, 1] = g[1, 0] = 0.0  # u is centred
@@ -320,7 +326,7 @@ def fit_harmonics(x: np.ndarray, y: np.ndarray | None, theta: float, n_harm: int
     sum_sq = _sums_of_squares([x, y] if use_y else [x], edges)
     for s in range(n_seg):
         length = int(lengths[s])
-        if length < 2 * n_harm + 2:
+        if length < fit_parameter_count(n_harm):
             phasors[:, s, :] = np.nan
             continue
         g = _gram(theta, int(edges[s]), length, n_harm)
@@ -472,7 +478,7 @@ def _segment_phasors(re: np.ndarray, im: np.ndarray, tk: np.ndarray, parts: np.n
     for s in range(n_seg):
         a, b = first[s], first[s + 1]
         length = int(edges[s + 1] - edges[s])
-        if length < 2 * n_harm + 2:
+        if length < fit_parameter_count(n_harm):
             phasors[:, s, :] = np.nan
             continue
         g = _gram(theta, int(edges[s]), length, n_harm)

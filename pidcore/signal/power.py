@@ -78,7 +78,7 @@ from ..loop import ForceDisplacementLoop
 from ..records import Channel
 from . import validate
 from .frequency import estimate_drive_frequency
-from .harmonics import HarmonicFit, fit_harmonics
+from .harmonics import HarmonicFit, fit_harmonics, fit_parameter_count
 
 
 @dataclass(frozen=True)
@@ -545,7 +545,7 @@ def _check_stationary_drive(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
     loss = 1.0 - float(abs(np.mean(fundamentals))) / mean_amplitude
     if loss <= defaults.DRIVE_COHERENCE_NOTED_LOSS:
         return ""
-    n_params = 2 * fit.phasors.shape[2] + 2
+    n_params = fit_parameter_count(fit.phasors.shape[2])
     # a block a few samples longer than the fit's parameters has no noise estimate to judge
     # its phase by (one period of 12.8 samples at 12 parameters leaves under 1 degree of
     # freedom, and the near-saturated fit multiplies its noise): a steady drive at 20 dB was
@@ -772,11 +772,12 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         # a block of fewer samples than the fit's parameters (harmonics, DC and trend) has no
         # phasors (NaN): one period of 11.6 samples at 5 harmonics holds 11 for 12
         shortest = int(np.min(np.diff(edges[:k_blocks + 1])))
-        if shortest < 2 * n_harm + 2:
+        n_params = fit_parameter_count(n_harm)
+        if shortest < n_params:
             edges = np.array([0, n_samples], dtype=np.int64)
             uncertainty_note = (f"no standard error: blocks of {shortest} samples "
                                 f"({per_block} period(s) each of {k_blocks}) hold fewer than "
-                                f"the fit's {2 * n_harm + 2} parameters ({n_harm} harmonics, DC "
+                                f"the fit's {n_params} parameters ({n_harm} harmonics, DC "
                                 "and trend)")
             k_blocks = 0
     else:
