@@ -139,6 +139,8 @@ def shared_identity(table: pd.DataFrame) -> dict[str, str]:
             if len(values) == 1 and "" not in values:
                 out[column] = values.pop()
     return out
+
+
 #: Columns an analyses table needs (as :meth:`pidcore.store.Store.list_analyses` gives, with the
 #: load case fields the report pipeline stores in each record).
 ANALYSIS_COLUMNS: tuple[str, ...] = ("frequency_hz", "acceleration_g", "fill_percent", "sdc",
