@@ -17,7 +17,7 @@ import os
 import threading
 import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -738,13 +738,10 @@ def _run_dask(todo: Iterable[tuple[LoadCase, str]], config: DemConfig, scheduler
             client.cancel(futures)
             raise
     finally:
-        if lost:
-            # closing ends the client's attempts to reconnect, which dask logs as an ERROR
-            # (asyncio's CancelledError with its traceback, or "Failed to reconnect") after
-            # the one line
-            with _distributed_silenced():
-                client.close()
-        else:
+        # with the connection lost, closing ends the client's attempts to reconnect, which
+        # dask logs as an ERROR (asyncio's CancelledError with its traceback, or "Failed to
+        # reconnect") after the one line
+        with _distributed_silenced() if lost else nullcontext():
             client.close()
 
 
