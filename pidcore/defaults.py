@@ -67,6 +67,20 @@ DRIVE_PHASE_NOISE_FACTOR = 10.0
 #: loss noise makes in 2e-3 of records (a steady drive refused), with 2 in 6e-6, with 4 under
 #: 1e-6 (2 million draws of that model).
 DRIVE_PHASE_MIN_DOF = 4
+#: Smallest departure, as a fraction, of one block's drive-line amplitude from the median
+#: block's that counts as that channel not holding its line there (a sensor dropout): one
+#: block of 8 at 5 % moves the record's fit by 0.6 %. A vibrometer losing its return for 5 %
+#: of a record takes 40 % of one block's amplitude.
+BLOCK_AMPLITUDE_MIN_DEPARTURE = 0.05
+#: A block's departure (:data:`BLOCK_AMPLITUDE_MIN_DEPARTURE`) must also exceed this many times
+#: the larger of the blocks' own spread (1.4826 x their median absolute departure) and the
+#: median block's noise: the DEM bed's force line moves +-5 % from block to block at 50 Hz,
+#: 5 g, and 8 normal draws exceed 6 x their MAD spread in 2.6 % of records, 6 sigma of noise
+#: in ~1e-8; both together with the 5 % floor keep a steady record from being flagged.
+BLOCK_AMPLITUDE_SPREAD_FACTOR = 6.0
+#: Fewest blocks of the standard error the amplitude check (:data:`BLOCK_AMPLITUDE_MIN_DEPARTURE`)
+#: needs: a median and a spread of fewer do not tell the steady blocks.
+BLOCK_AMPLITUDE_MIN_BLOCKS = 6
 #: Widest angle, in degrees, of the complex power below the force's line (Re(P_c) > 0,
 #: Im(P_c) <= 0) at which a refusal of a negative reactive power says the motion channel may
 #: hold the wrong quantity. A motion channel holding the derivative of its quantity (an

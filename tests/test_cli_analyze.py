@@ -396,9 +396,10 @@ def test_table_shows_a_missing_standard_error_as_na_not_nan(tmp_path, capsys):
     t = np.arange(int(40 * FS / FREQ)) / FS
     v = 0.01 * np.sin(w * t)
     x = -0.01 / w * np.cos(w * t)
-    # first 5 periods a spring (Im < 0; k = 0.2 m w^2 keeps the whole record's Im resolved),
-    # then a mass with a damper
-    force = np.where(t < 5 / FREQ, 0.2 * MASS * w**2 * x,
+    # the first block (4 periods: 39 whole ones make 8 blocks of 4) a spring (Im < 0), then a
+    # mass with a damper; k = m w^2 gives the spring's force the mass's amplitude (a block
+    # whose line is weaker is refused as a dropout) and keeps the record's Im resolved
+    force = np.where(t < 4 / FREQ, MASS * w**2 * x,
                      MASS * 0.01 * w * np.cos(w * t) + C_VISCOUS * v)
     path = tmp_path / "spring_block.csv"
     write_force_velocity(path, force, v, FS, "csv")

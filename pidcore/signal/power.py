@@ -588,6 +588,64 @@ def _check_stationary_drive(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
         "constant frequency")
 
 
+def _check_block_amplitudes(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
+                            sample_rate_hz: float, *, names: tuple[str, str],
+                            source: str) -> str:
+    """Refuse a record where one channel's drive line drops out in some blocks of the standard
+    error (or rises) while the rest of the record is steady, or return a note where the
+    result moves less ("" where no block stands out).
+
+    A vibrometer losing its return (or a cable, a trigger) records noise instead of the
+    motion for a while; the one fit of the record then has that much less of the channel's
+    line and the energy per cycle came out low without a word (5 % of a record: -5 %), while
+    the stretch's samples are no run of identical values (:func:`validate.dropout_runs`). A
+    block is out where its fundamental's amplitude departs from the median block's by more
+    than :data:`~pidcore.defaults.BLOCK_AMPLITUDE_MIN_DEPARTURE`, than
+    :data:`~pidcore.defaults.BLOCK_AMPLITUDE_SPREAD_FACTOR` x the blocks' own spread (their
+    median absolute departure, a bed's cycle-to-cycle force) and than as many times the
+    median block's noise: a beat or a slow ramp moves every block and none stands out. The
+    record's fit, about the blocks' mean, then departs from the steady blocks by the out
+    blocks' departures over the block count, which is what the message says."""
+    spare = int(np.min(np.diff(edges[:n_blocks + 1]))) - fit_parameter_count(
+        fit.phasors.shape[2])
+    # the noise of a block with fewer spare samples is no yardstick (see the phase check)
+    if n_blocks < defaults.BLOCK_AMPLITUDE_MIN_BLOCKS or spare < defaults.DRIVE_PHASE_MIN_DOF:
+        return ""
+    said = []
+    worst = 0.0
+    for channel, name in enumerate(names):
+        amplitudes = np.abs(fit.phasors[channel, :n_blocks, 0])
+        median = float(np.median(amplitudes))
+        if not median > 0:
+            continue
+        departure = amplitudes / median - 1.0
+        spread = 1.4826 * float(np.median(np.abs(departure)))  # a normal's sigma from its MAD
+        noise = math.sqrt(float(np.median(fit.fundamental_variance[channel, :n_blocks]))) / median
+        limit = max(defaults.BLOCK_AMPLITUDE_MIN_DEPARTURE,
+                    defaults.BLOCK_AMPLITUDE_SPREAD_FACTOR * max(spread, noise))
+        out = np.flatnonzero(np.abs(departure) > limit)
+        if not out.size:
+            continue
+        effect = float(np.sum(departure[out])) / n_blocks
+        worst = max(worst, abs(effect))
+        blocks = ", ".join(
+            f"{i + 1} ({edges[i] / sample_rate_hz:.4g}-{edges[i + 1] / sample_rate_hz:.4g} s: "
+            f"{100 * abs(departure[i]):.3g} % {'less' if departure[i] < 0 else 'more'})"
+            for i in out)
+        said.append(f"channel {name!r} holds its drive line steady in the other blocks of "
+                    f"{n_blocks} but not in block(s) {blocks} (a sensor dropout, a vibrometer "
+                    "losing its return, a cable or a structure changing mid-record); the "
+                    f"record's fit of it is about {100 * abs(effect):.2g} % "
+                    f"{'low' if effect < 0 else 'high'} against the steady blocks")
+    if not said:
+        return ""
+    if worst <= defaults.DRIVE_COHERENCE_MAX_LOSS:
+        return "drive line not steady in every block: " + "; ".join(said)
+    raise SignalError(f"{source or 'record'}: {'; '.join(said)}; "
+                      f"{100 * defaults.DRIVE_COHERENCE_MAX_LOSS:g} % allowed: analyse a "
+                      "stretch without those blocks")
+
+
 def _drift_knots(whole: int, n_samples: int, sample_rate_hz: float,
                  frequency_hz: float) -> np.ndarray | None:
     """Knots of the drift's cubic spline: every ``DRIFT_KNOT_PERIODS`` whole periods, the
@@ -846,6 +904,11 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         raise SignalError(
             f"{source or 'record'}: reactive power Im(P_c) = {p_c.imag:.4g} W <= 0 (no "
             f"positive kinetic energy: a mass-like structure gives Im(P_c) > 0); {cause}")
+    # a drive whose phase moves (said above) moves the blocks' amplitudes at the record's
+    # frequency too: that is not a channel dropping out
+    steady_note = (_check_block_amplitudes(fit, k_blocks, edges, sample_rate_hz,
+                                           names=(force_name, motion_name), source=source)
+                   if k_blocks and not stationary_note else "")
 
     loss_raw = p_c.real / p_c.imag if p_c.imag != 0 else math.nan
     # the empty structure's share of the reactive power, whose baseline_loss_factor it
@@ -929,7 +992,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         uncertainty_note=uncertainty_note,
         corrections=corrections,
         notes=tuple(n for n in (zeta_note, uncertainty_note, baseline_note, drift_note,
-                                harmonics_note, delay_note, stationary_note) if n),
+                                harmonics_note, delay_note, stationary_note, steady_note) if n),
     )
 
 
