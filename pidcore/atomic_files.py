@@ -52,6 +52,15 @@ def file_in_the_way(path: str | os.PathLike[str]) -> Path | None:
     return None
 
 
+def real_folder(out: str | os.PathLike[str]) -> Path:
+    """The folder an output path names, as an absolute path with every link, ``.`` and ``..``
+    resolved: where it is a link, the folder the link points to, which is written (and its
+    build folders made beside it) while the link is kept. ``--out .`` has no name to build a
+    folder beside, and ``sub/..`` is the current folder, which only its resolved path tells
+    (:func:`pidcore.out_folder.check_replaceable`)."""
+    return Path(os.path.realpath(out))
+
+
 def new_file_mode() -> int:
     """The permissions a new file gets here: 0o666 less the process's umask."""
     return 0o666 & ~_process_umask()
@@ -457,9 +466,11 @@ def move_files_into_folder(work: str | os.PathLike[str], target: str | os.PathLi
     ``target`` as it was (and a build folder, removed by the build folders' clean-up); a
     kill after it, moves that :func:`finish_committed_moves`, called by the next write
     before anything else, completes (rolls forward). Files of other names in ``target`` are
-    never touched.
+    never touched. A ``target`` that is a link to a folder stays a link: the commit is made
+    beside the folder it points to (:func:`real_folder`), where ``work`` is to be built, so
+    that every move is a rename on that folder's file system.
     """
-    work, target = Path(work), Path(target)
+    work, target = Path(work), real_folder(target)
     commit = target.with_name(f".{target.name}.{secrets.token_hex(8)}{COMMITTED_FOLDER_SUFFIX}")
     os.replace(work, commit)
     _fsync_folder_of(target)  # the commit on disk before the moves it allows
@@ -492,18 +503,22 @@ def finish_committed_moves(target: str | os.PathLike[str]) -> list[Path]:
     a link, is taken (by the rule of the build folders' clean-up), and of it only plain
     files; of several (only writes running at once leave more than one), the least recently
     changed first. Where ``target`` is no folder (removed since, with the files already moved
-    into it), the rest cannot make a whole set and is removed.
+    into it), the rest cannot make a whole set and is removed. For a ``target`` that is a link
+    to a folder, both beside the folder (where the commit is made) and beside the link (where
+    an earlier pidcore made it) are looked in.
     """
     import shutil
 
     target = Path(target)
-    pattern = committed_folder_name_pattern(target)
-    try:
-        found = sorted((entry.lstat().st_ctime, entry) for entry in _stale_entries(
-            target.parent, lambda name: pattern.fullmatch(name) is not None, stat.S_ISDIR,
-            0.0, None))
-    except OSError:  # no parent yet, or one that cannot be listed: nothing left there
-        return []
+    found = []
+    for place in dict.fromkeys((Path(os.path.abspath(target)), real_folder(target))):
+        pattern = committed_folder_name_pattern(place)
+        # no parent yet, or one that cannot be listed: nothing left there
+        with suppress(OSError):
+            found += [(entry.lstat().st_ctime, entry) for entry in _stale_entries(
+                place.parent, lambda name, pattern=pattern: pattern.fullmatch(name) is not None,
+                stat.S_ISDIR, 0.0, None)]
+    found.sort()
     moved: list[Path] = []
     for _, commit in found:
         if target.is_dir():  # a link to a folder too: the outputs were moved through it

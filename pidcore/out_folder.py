@@ -34,6 +34,7 @@ from . import interrupt
 from .atomic_files import (
     fsync_tree,
     new_temporary_folder_for,
+    real_folder,
     replace_folder,
     restore_previous_folder,
 )
@@ -42,14 +43,6 @@ from .errors import ParameterError
 #: The record a run writes into its output folder: ``{"written_by": "pidcore <command>",
 #: "files": {path in the folder (``/``-separated): SHA-256 of its bytes}}``.
 RECORD_NAME = ".pidcore-outputs.json"
-
-
-def real_folder(out: str | os.PathLike[str]) -> Path:
-    """The folder an ``--out`` names, as an absolute path with every link, ``.`` and ``..``
-    resolved: where it is a link, the folder the link points to, which is replaced while the
-    link is kept. ``--out .`` has no name to build a folder beside, and ``sub/..`` is the
-    current folder, which only its resolved path tells (:func:`check_replaceable`)."""
-    return Path(os.path.realpath(out))
 
 
 def _sha256(path: Path) -> str:

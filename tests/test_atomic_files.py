@@ -324,6 +324,13 @@ def test_finishing_committed_moves_takes_only_plain_files_of_its_own_exact_name(
     (through / "summary.md").write_text("newer")
     assert atomic_files.finish_committed_moves(target) == [target / "summary.md"]
     assert (linked / "summary.md").read_text() == "newer" and not through.exists()
+    # where move_files_into_folder commits now, beside the folder the link points to: found
+    # through the link too (a reader given the link's path missed it and read a mix of two)
+    beside = tmp_path / f".cal.{'4d' * 8}.commit"
+    beside.mkdir()
+    (beside / "summary.md").write_text("newest")
+    assert atomic_files.finish_committed_moves(target) == [target / "summary.md"]
+    assert (linked / "summary.md").read_text() == "newest" and not beside.exists()
     target.unlink()
     target = linked
     # cal removed after the kill: the files moved before it went with it, the rest is no set

@@ -1279,3 +1279,73 @@ def test_the_out_files_say_the_notes_in_the_commands_words(capsys, tmp_path, tin
     # the document keeps the library's words, as the store keeps it (its key covers them)
     notes = json.loads((out / "calibration.json").read_text())["notes"]
     assert any("(priors=fixture_mass_kg=LOW:HIGH)" in note for note in notes)
+
+
+def _stand_in_outputs(monkeypatch, during_build=lambda: None) -> None:
+    """write_outputs with each output a stand-in text (what the files hold is not what the
+    folder tests test); ``during_build`` is called while the figures are drawn, mid-build."""
+    import pidcore.calibrate.outputs as outputs
+
+    monkeypatch.setattr(outputs, "document_json", lambda document: "calibration.json")
+    for name in ("specimen_text", "summary_markdown", "summary_html"):
+        monkeypatch.setattr(outputs, name, lambda result, name=name: name)
+
+    def plot(result, path):
+        during_build()
+        Path(path).write_text("figure")
+    for name in ("plot_predictions", "plot_pairs"):
+        monkeypatch.setattr(outputs, name, plot)
+
+
+def test_an_out_that_links_to_a_folder_keeps_the_link_and_its_folder_gets_the_outputs(
+        tmp_path, monkeypatch):
+    # `ln -s elsewhere/cal cal; pidcore calibrate --out cal` built the outputs beside the
+    # link, and a link to a folder yet to be made was replaced by a real folder: now as
+    # report --out and model --out, the link stays and its folder gets them, built beside it
+    from types import SimpleNamespace
+
+    from pidcore.calibrate import write_outputs
+
+    links, elsewhere = tmp_path / "links", tmp_path / "elsewhere"
+    links.mkdir()
+    elsewhere.mkdir()
+    seen = []
+    _stand_in_outputs(monkeypatch, lambda: seen.append(sorted(os.listdir(links))))
+    outputs = ["calibration.json", "calibrated_specimen.toml", "summary.md", "summary.html",
+               "predictions.png", "posterior_pairs.png"]
+    link = links / "cal"
+    link.symlink_to(Path("..") / "elsewhere" / "cal")  # relative, as ln -s writes it
+    for run in ("a folder yet to be made", "an existing folder with a user's file"):
+        paths = write_outputs(SimpleNamespace(full_document=dict, notes=[]), link)
+        assert link.is_symlink() and link.readlink() == Path("..") / "elsewhere" / "cal", run
+        assert sorted(p.name for p in (elsewhere / "cal").iterdir()) == sorted(
+            outputs + (["notes.txt"] if run.endswith("file") else [])), run
+        assert paths == [link / name for name in outputs]  # as the user named it
+        (elsewhere / "cal" / "notes.txt").write_text("a user's")
+    assert (elsewhere / "cal" / "notes.txt").read_text() == "a user's"
+    # nothing built beside the link while the figures were drawn, nor left there after
+    assert seen == [["cal"]] * 4 and os.listdir(links) == ["cal"]
+    assert os.listdir(elsewhere) == ["cal"]
+
+
+def test_an_out_that_links_to_a_folder_on_another_file_system_gets_the_outputs(
+        tmp_path, monkeypatch):
+    # a link to a folder on another disk: the files built beside the link could not be
+    # renamed into it (OSError: Invalid cross-device link, a traceback after the DEM runs)
+    import tempfile
+    from types import SimpleNamespace
+
+    from pidcore.calibrate import write_outputs
+
+    shm = Path("/dev/shm")
+    if not shm.is_dir() or shm.stat().st_dev == tmp_path.stat().st_dev:
+        pytest.skip("no second file system (/dev/shm) here to put the link's folder on")
+    _stand_in_outputs(monkeypatch)
+    with tempfile.TemporaryDirectory(dir=shm) as other:
+        real = Path(other) / "cal"
+        real.mkdir()
+        link = tmp_path / "cal"
+        link.symlink_to(real)
+        write_outputs(SimpleNamespace(full_document=dict, notes=[]), link)
+        assert link.is_symlink() and len(os.listdir(real)) == 6
+        assert os.listdir(tmp_path) == ["cal"] and os.listdir(other) == ["cal"]

@@ -18,6 +18,7 @@ from ..atomic_files import (
     fsync_tree,
     move_files_into_folder,
     new_temporary_folder_for,
+    real_folder,
 )
 from ..plot_text import text_as_typed
 from ..records import json_safe
@@ -482,6 +483,8 @@ def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike, *,
     of other names in it are kept). A kill (SIGKILL, a power loss) while the files are moved
     into an existing ``out_dir`` is completed by the next write
     (:func:`finish_interrupted_outputs`, :func:`pidcore.atomic_files.move_files_into_folder`).
+    An ``out_dir`` that is a link to a folder stays a link, and the folder it points to gets
+    the outputs, built beside it, as a report's ``out_dir`` does.
     """
     import shutil
 
@@ -496,10 +499,14 @@ def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike, *,
              (SPECIMEN_FILE, specimen_text(said)),
              ("summary.md", summary_markdown(said)),
              ("summary.html", summary_html(said)))
-    out.parent.mkdir(parents=True, exist_ok=True)
+    # a link to a folder stays a link: the folder it points to gets the outputs, built beside
+    # it (beside the link, a link to another disk's folder failed to move them there, and one
+    # to a folder yet to be made was replaced by a real folder)
+    real = real_folder(out)
+    real.parent.mkdir(parents=True, exist_ok=True)
     finish_interrupted_outputs(out)  # before this write's: the earlier set whole, then replaced
     # beside out_dir: on its file system, so that the moves below are renames
-    work = new_temporary_folder_for(out)
+    work = new_temporary_folder_for(real)
     try:
         names = []
         for name, text in texts:
@@ -511,10 +518,10 @@ def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike, *,
             names.append(name)
         fsync_tree(work)  # the files on disk before the renames that name them
         with interrupt.deferred():
-            if not out.exists():
-                os.replace(work, out)
+            if not real.exists():
+                os.replace(work, real)
             else:  # a folder (check_out_folder): each file replaced, the set in one step
-                move_files_into_folder(work, out)
+                move_files_into_folder(work, real)
     finally:
         shutil.rmtree(work, ignore_errors=True)
     return [out / name for name in names]

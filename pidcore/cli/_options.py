@@ -98,8 +98,7 @@ def check_out_folder(out: Path, *, built_beside: bool = False) -> None:
     beside its siblings; ``built_beside``, its files are also built in a folder beside it
     (:func:`pidcore.atomic_files.new_temporary_folder_for`). Checked before any work, so a
     long run is not thrown away at the end."""
-    from ..atomic_files import check_folder_can_be_made, file_in_the_way
-    from ..out_folder import real_folder
+    from ..atomic_files import check_folder_can_be_made, file_in_the_way, real_folder
 
     if out.exists() and not out.is_dir():
         raise ParameterError(f"--out {out}: exists and is not a folder")

@@ -24,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
-from ..atomic_files import check_folder_can_be_made
+from ..atomic_files import check_folder_can_be_made, real_folder
 from ..compare.align import Aligner, Tolerances
 from ..compare.case import saved_parameters
 from ..compare.loadcase import LoadCase, StatedLoadCase
@@ -34,7 +34,6 @@ from ..errors import ParameterError, StoreError
 from ..interrupt import untouched
 from ..io import display_path
 from ..loadcase import refuse_identical_contents_stating_apart
-from ..out_folder import real_folder
 from .provenance import calibration_provenance, collect_provenance
 from .render import (
     CASE_SHEETS_FOLDER,
