@@ -274,6 +274,28 @@ def check_folder_can_be_made(target: str | os.PathLike[str], *, label: str = "")
         probe.rmdir()
 
 
+@contextmanager
+def refused_unless_written(folder: str | os.PathLike[str], what: str, *,
+                           then: str = "") -> Iterator[None]:
+    """Around the write of ``what`` (``"the report"``) into the output folder ``folder``,
+    whole or not at all: an ``OSError`` (a full disk or quota, ENOSPC or EDQUOT; a folder made
+    read-only since it was checked) becomes one line, a ``ParameterError`` naming ``folder``,
+    the system's reason and the file it failed on, and saying that ``folder`` is as it was
+    (:func:`pidcore.interrupt.untouched`), ``then`` appended. The one rule of every command
+    that writes such a folder: the error came as a traceback after all the work. Only around
+    a write that leaves ``folder`` as it was when it fails (its build folder removed)."""
+    from .errors import ParameterError
+    from .interrupt import untouched
+
+    try:
+        yield
+    except OSError as exc:
+        raise ParameterError(
+            f"{folder}: {what} could not be written ({exc.strerror or exc}"
+            f"{': ' + str(exc.filename) if exc.filename else ''}); {untouched(folder)} "
+            f"(written whole or not at all){then}") from None
+
+
 #: Marks an earlier folder moved aside (``.<name>.<16 hex>.old``) while :func:`replace_folder`
 #: renames its replacement into place, where the system cannot swap the two in one step.
 PREVIOUS_FOLDER_SUFFIX = ".old"

@@ -124,3 +124,26 @@ def calibration_outputs_script(stand_ins: str = "") -> str:
         + stand_ins
         + "arm_the_kill()\n"
         "outputs.write_outputs(SimpleNamespace(full_document=dict), sys.argv[3])\n")
+
+
+def fill_the_disk_at_file(monkeypatch, nth: int) -> list[Path]:
+    """The disk full (ENOSPC) from the ``nth`` (from 1) file an output folder's build flushes
+    on: :func:`pidcore.atomic_files.fsync_path` of it raises ``OSError(ENOSPC)`` naming it, as
+    the write or flush of a file fails when the disk fills mid-way; returns the files flushed
+    before it (the build got that far)."""
+    import errno
+
+    from pidcore import atomic_files
+
+    real = atomic_files.fsync_path
+    flushed: list[Path] = []
+
+    def fsync_path(path, *, directory=False):
+        if not directory:
+            if len(flushed) + 1 >= nth:
+                raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+            flushed.append(Path(path))
+        real(path, directory=directory)
+
+    monkeypatch.setattr(atomic_files, "fsync_path", fsync_path)
+    return flushed

@@ -1349,3 +1349,39 @@ def test_an_out_that_links_to_a_folder_on_another_file_system_gets_the_outputs(
         write_outputs(SimpleNamespace(full_document=dict, notes=[]), link)
         assert link.is_symlink() and len(os.listdir(real)) == 6
         assert os.listdir(tmp_path) == ["cal"] and os.listdir(other) == ["cal"]
+
+
+def test_a_disk_that_fills_while_the_outputs_are_written_is_one_line_and_keeps_the_earlier_ones(
+        capsys, tmp_path, tiny_store, monkeypatch):
+    # a full disk (ENOSPC) or quota (EDQUOT) while the figures were written ended in an
+    # OSError traceback after the DEM runs and the fit: now one line naming the folder and
+    # the file, exit 2, the folder's earlier outputs and a user's file as they were, and
+    # nothing built left beside it
+    import errno
+
+    import pidcore.calibrate.outputs as outputs
+
+    out = tmp_path / "cal"
+    out.mkdir()
+    earlier = {"calibration.json": b"{}", "summary.md": b"the earlier calibration's",
+               "notes.txt": b"a user's"}
+    for name, data in earlier.items():
+        (out / name).write_bytes(data)
+
+    def full(result, path):
+        Path(path).write_bytes(b"\x89PNG half")  # the disk filled mid-file
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+
+    monkeypatch.setattr(outputs, "plot_predictions", full)
+    code = main(["calibrate", "--data", str(_table(tmp_path)), "--fit", "fixture_mass_kg",
+                 "--discrepancy", "0.2", "--dem-store", str(tiny_store), "--out", str(out),
+                 *TINY])
+    err = capsys.readouterr().err
+    assert code == 2, err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert re.fullmatch(
+        rf"pidcore calibrate: error: {re.escape(str(out))}: the calibration's outputs could "
+        r"not be written \(No space left on device: \S+/predictions\.png\); "
+        rf"{re.escape(str(out))} unchanged \(written whole or not at all\)\n", err), err
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == earlier
+    assert sorted(os.listdir(tmp_path)) == ["cal", "m.csv"]

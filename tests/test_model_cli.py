@@ -1056,3 +1056,34 @@ def test_a_hidden_earlier_output_folder_holding_a_users_file_is_refused_not_remo
     assert sorted(p.name for p in tmp_path.iterdir()) == ["d"]
     assert sorted(p.name for p in (tmp_path / "d").iterdir()) == [RECORD_NAME,
                                                                   "equivalent_damper.json"]
+
+
+@pytest.mark.parametrize("command, what", [("damper", "the damper table"),
+                                           ("figures", "the figures")])
+def test_a_disk_that_fills_while_the_outputs_are_written_is_one_line_and_keeps_the_earlier_ones(
+        tmp_path, monkeypatch, capsys, command, what):
+    # a full disk (ENOSPC) or quota (EDQUOT) mid-way through the files ended in an OSError
+    # traceback: now one line naming the folder and the file, exit 2, and the folder holds
+    # the earlier run's outputs as they were, with nothing built left beside it
+    import os
+
+    from _build_leftovers import fill_the_disk_at_file
+    from matplotlib.figure import Figure
+
+    monkeypatch.setattr(Figure, "savefig", lambda fig, target, **_: target.write(b"x"))
+    out = tmp_path / "out"
+    argv = ["model", command, "--out", str(out)]
+    if command == "damper":
+        argv += ["--fills", "50", "--accelerations", "5", "--frequencies", "100"]
+    assert _run_main(argv) == 0
+    before = _files(out)
+    capsys.readouterr()
+    flushed = fill_the_disk_at_file(monkeypatch, 2)
+    assert _run_main(argv) == 2
+    err = capsys.readouterr().err
+    assert len(flushed) == 1  # mid-way: a file was written before the disk filled
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert err.startswith(f"pidcore model {command}: error: {out}: {what} could not be "
+                          "written (No space left on device: "), err
+    assert err.endswith(f"); {out} unchanged (written whole or not at all)\n"), err
+    assert _files(out) == before and os.listdir(tmp_path) == ["out"]

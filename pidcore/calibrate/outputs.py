@@ -19,6 +19,7 @@ from ..atomic_files import (
     move_files_into_folder,
     new_temporary_folder_for,
     real_folder,
+    refused_unless_written,
 )
 from ..plot_text import text_as_typed
 from ..records import json_safe
@@ -484,7 +485,9 @@ def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike, *,
     into an existing ``out_dir`` is completed by the next write
     (:func:`finish_interrupted_outputs`, :func:`pidcore.atomic_files.move_files_into_folder`).
     An ``out_dir`` that is a link to a folder stays a link, and the folder it points to gets
-    the outputs, built beside it, as a report's ``out_dir`` does.
+    the outputs, built beside it, as a report's ``out_dir`` does. A write that fails (a full
+    disk) is a ``ParameterError`` naming the file, ``out_dir`` left as it was
+    (:func:`pidcore.atomic_files.refused_unless_written`).
     """
     import shutil
 
@@ -503,25 +506,30 @@ def write_outputs(result: CalibrationResult, out_dir: str | os.PathLike, *,
     # it (beside the link, a link to another disk's folder failed to move them there, and one
     # to a folder yet to be made was replaced by a real folder)
     real = real_folder(out)
-    real.parent.mkdir(parents=True, exist_ok=True)
-    finish_interrupted_outputs(out)  # before this write's: the earlier set whole, then replaced
-    # beside out_dir: on its file system, so that the moves below are renames
-    work = new_temporary_folder_for(real)
+    work = None
     try:
-        names = []
-        for name, text in texts:
-            (work / name).write_text(text, encoding="utf-8")
-            names.append(name)
-        for name, plot in (("predictions.png", plot_predictions),
-                           ("posterior_pairs.png", plot_pairs)):
-            plot(result, work / name)
-            names.append(name)
-        fsync_tree(work)  # the files on disk before the renames that name them
+        # a full disk or quota up to the commit below leaves out_dir as it was: one line
+        with refused_unless_written(out, "the calibration's outputs"):
+            real.parent.mkdir(parents=True, exist_ok=True)
+            # before this write's: the earlier set whole, then replaced
+            finish_interrupted_outputs(out)
+            # beside out_dir: on its file system, so that the moves below are renames
+            work = new_temporary_folder_for(real)
+            names = []
+            for name, text in texts:
+                (work / name).write_text(text, encoding="utf-8")
+                names.append(name)
+            for name, plot in (("predictions.png", plot_predictions),
+                               ("posterior_pairs.png", plot_pairs)):
+                plot(result, work / name)
+                names.append(name)
+            fsync_tree(work)  # the files on disk before the renames that name them
         with interrupt.deferred():
             if not real.exists():
                 os.replace(work, real)
             else:  # a folder (check_out_folder): each file replaced, the set in one step
                 move_files_into_folder(work, real)
     finally:
-        shutil.rmtree(work, ignore_errors=True)
+        if work is not None:
+            shutil.rmtree(work, ignore_errors=True)
     return [out / name for name in names]

@@ -15,6 +15,7 @@ import sys
 from pathlib import Path
 
 from .. import defaults
+from ..atomic_files import refused_unless_written
 from ..constants import PARTICLE_MATERIALS, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError, as_given
 from ..out_folder import check_replaceable, write_folder_whole
@@ -424,10 +425,12 @@ def run_damper(args: argparse.Namespace) -> int:
            "would lose all its energy within a cycle): left empty")
     if undefined:
         provenance["damping_ratio"] = why
-    paths = write_folder_whole(
-        args.out, "model damper",
-        lambda folder: write_damper_table(table, folder, formats=args.format, stem=DAMPER_STEM,
-                                          provenance=provenance), option="--out")
+    with refused_unless_written(args.out, "the damper table"):
+        paths = write_folder_whole(
+            args.out, "model damper",
+            lambda folder: write_damper_table(table, folder, formats=args.format,
+                                              stem=DAMPER_STEM, provenance=provenance),
+            option="--out")
     for path in paths:
         print(path)
     print(f"pidcore model damper: note: coupon area {area_text}", file=sys.stderr)
@@ -505,7 +508,8 @@ def run_figures(args: argparse.Namespace) -> int:
             paths += save_figure(fig, folder, f"sdc_vs_frequency_{acc:g}g")
         return paths
 
-    with figure_fonts() as missing:  # a specimen's or store's name in CJK in the titles
+    # a specimen's or store's name in CJK in the titles
+    with figure_fonts() as missing, refused_unless_written(args.out, "the figures"):
         paths = write_folder_whole(args.out, "model figures", draw, option="--out")
     for path in paths:
         print(path)

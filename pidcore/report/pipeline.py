@@ -24,14 +24,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import pandas as pd
 
-from ..atomic_files import check_folder_can_be_made, real_folder
+from ..atomic_files import check_folder_can_be_made, real_folder, refused_unless_written
 from ..compare.align import Aligner, Tolerances
 from ..compare.case import saved_parameters
 from ..compare.loadcase import LoadCase, StatedLoadCase
 from ..compare.specimens import NOT_PAPER_SPECIMEN_NOTE
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError, StoreError
-from ..interrupt import untouched
 from ..io import display_path
 from ..loadcase import refuse_identical_contents_stating_apart
 from .provenance import calibration_provenance, collect_provenance
@@ -1119,16 +1118,11 @@ def make_report(files: Sequence[str | Path], *, out_dir: str | Path,
             stores=stores, notes=notes, specimens=specimen_provenance(specimen, table),
             calibrations=calibration_provenance(calibrated),
             case_sheets=[(f"{CASE_SHEETS_FOLDER}/{s.name}", s.title, s.pdf) for s in sheets])
-        try:
+        saved = (f"; the analyses of the {len(results)} file(s) were saved to {store} "
+                 "before it (whole)" if main is not None and results else "")
+        with refused_unless_written(out_dir, "the report", then=saved):
             paths = write_report(table, figures, provenance, out_dir, formats,
                                  progress=progress, case_sheets={s.name: s.pdf for s in sheets})
-        except OSError as exc:  # a full disk, a folder made read-only since the check
-            saved = (f"; the analyses of the {len(results)} file(s) were saved to {store} "
-                     "before it (whole)" if main is not None and results else "")
-            raise ParameterError(
-                f"{out_dir}: the report could not be written ({exc.strerror or exc}"
-                f"{': ' + str(exc.filename) if exc.filename else ''}); {untouched(out_dir)} "
-                f"(a report is written whole or not at all){saved}") from None
     finally:
         for fig in figures.values():  # bare Figures: drop references to free Agg buffers
             fig.clear()
