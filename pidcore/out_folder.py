@@ -45,12 +45,6 @@ from .errors import ParameterError
 RECORD_NAME = ".pidcore-outputs.json"
 
 
-def _sha256(path: Path) -> str:
-    from .report.provenance import sha256_file
-
-    return sha256_file(path)
-
-
 def _read_record(folder: Path) -> tuple[str, dict[str, str]] | None:
     """``(written_by, files)`` of ``folder``'s record; None where it has none that can be
     read (absent, not JSON, or not of the record's form)."""
@@ -74,12 +68,14 @@ def written_by(folder: str | os.PathLike[str], command: str) -> bool:
 
 def _write_record(work: Path, command: str) -> None:
     """Record every file under the build folder ``work`` (the run's outputs) in it."""
+    from .io import file_sha256
+
     files = {}
     for root, dirs, names in os.walk(work):
         dirs.sort()
         for name in sorted(names):
             path = Path(root, name)
-            files[path.relative_to(work).as_posix()] = _sha256(path)
+            files[path.relative_to(work).as_posix()] = file_sha256(path)
     # ASCII JSON: a file name that is not UTF-8 is kept as its escapes, read back the same
     (work / RECORD_NAME).write_text(
         json.dumps({"written_by": f"pidcore {command}", "files": files}, indent=1) + "\n",
@@ -89,7 +85,7 @@ def _write_record(work: Path, command: str) -> None:
 def _not_its_own(out: Path, command: str) -> str:
     """Why replacing the existing folder ``out`` would lose something that is not an unchanged
     output of ``pidcore command``'s last run there ("" where nothing)."""
-    from .io import display_path
+    from .io import display_path, file_sha256
 
     entries = sorted(out.iterdir())
     if not entries:
@@ -118,7 +114,7 @@ def _not_its_own(out: Path, command: str) -> str:
             if not kept:
                 return (f"holds {shown!r}, which pidcore {command} did not write there and "
                         "replacing its earlier outputs whole would delete")
-            if name in names and _sha256(path) != files[rel]:
+            if name in names and file_sha256(path) != files[rel]:
                 return (f"holds {shown!r} changed since pidcore {command} wrote it, which "
                         "replacing its earlier outputs whole would lose")
     return ""

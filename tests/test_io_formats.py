@@ -13,7 +13,7 @@ import scipy.io
 
 from pidcore.constants import STANDARD_GRAVITY
 from pidcore.errors import InputFileError, ParameterError
-from pidcore.io import read_measurement, read_measurements, write_measurement
+from pidcore.io import file_sha256, read_measurement, read_measurements, write_measurement
 from pidcore.io.hdf5_layout import write_measurement_group
 from pidcore.records import Channel, Measurement
 
@@ -64,6 +64,22 @@ def test_round_trip(tmp_path, suffix, file_format, binary, rtol):
     # The unknown channel keeps its unit text, so it reads back as the same unknown unit.
     assert read.channel("Bridge").source_unit == "V^2"
     assert [p.name for p in tmp_path.iterdir()] == [path.name]  # no temporary file left
+
+
+@pytest.mark.parametrize("size, chunk_bytes", [
+    (3 * 7 + 2, 7),  # three whole chunks and part of a fourth
+    ((1 << 20) + 1, 1 << 20),  # the default chunk, one byte over
+    (0, 7),  # an empty file: the hash of no bytes
+])
+def test_a_files_sha256_is_hashlibs_of_its_bytes_whatever_its_chunks(tmp_path, size,
+                                                                    chunk_bytes):
+    # the one file hash of measurements, reports' stores and the out folders' records: read
+    # in chunks, a chunk dropped or counted twice gives another digest, which hashlib's of the
+    # whole bytes read at once would not equal
+    data = np.random.default_rng(3).integers(0, 256, size, dtype=np.uint8).tobytes()
+    path = tmp_path / "x.bin"
+    path.write_bytes(data)
+    assert file_sha256(path, chunk_bytes=chunk_bytes) == hashlib.sha256(data).hexdigest()
 
 
 def test_uff_binary_flag_writes_58b(tmp_path):

@@ -14,9 +14,9 @@ from pidcore.cli import main
 from pidcore.compare import LoadCaseError
 from pidcore.constants import STANDARD_GRAVITY
 from pidcore.errors import StoreError
-from pidcore.io import write_measurement
+from pidcore.io import file_sha256, write_measurement
 from pidcore.records import Channel, Measurement
-from pidcore.report import make_report, sha256_file
+from pidcore.report import make_report
 from pidcore.report.table import ALIGNMENT_COLUMN
 from pidcore.signal import synthesize_shaker_record
 from pidcore.store import Store
@@ -76,7 +76,7 @@ def dem_store(tmp_path_factory):
 def e2e(tmp_path_factory, dem_store):
     folder = tmp_path_factory.mktemp("e2e")
     file = _write_measurement(folder / "coupon1_fill50_acrylic.csv")
-    dem_sha = sha256_file(dem_store)
+    dem_sha = file_sha256(dem_store)
     store = folder / "store.h5"
     result = make_report([file], out_dir=folder / "report", store=store, dem_store=dem_store,
                          formats="all")
@@ -87,7 +87,7 @@ def e2e(tmp_path_factory, dem_store):
 def test_report_end_to_end(e2e, dem_store):
     file, store, dem_sha, result = e2e
     # the dem store is only read
-    assert sha256_file(dem_store) == dem_sha
+    assert file_sha256(dem_store) == dem_sha
     # the analysis is in the store with its load case, and the table shows the stored numbers
     analyses = Store(store).list_analyses()
     assert len(analyses) == 1
@@ -110,7 +110,7 @@ def test_report_end_to_end(e2e, dem_store):
     assert not any("without DEM overlay" in n for n in result.notes)
     # provenance names the input's hash and the store's hash after the analysis was added
     text = result.paths["md"].read_text(encoding="utf-8")
-    assert sha256_file(file) in text and sha256_file(store) in text and dem_sha in text
+    assert file_sha256(file) in text and file_sha256(store) in text and dem_sha in text
 
 
 @pytest.mark.usefixtures("undrawn_report_figures")
@@ -294,7 +294,7 @@ def test_a_store_whose_name_is_not_utf8_is_reported_with_escapes(tmp_path, dem_s
                  "--format", "csv,md"]) == 0
     for folder in ("r", "r2"):
         text = (tmp_path / folder / "report.provenance.txt").read_text(encoding="utf-8")
-        assert f"store: {tmp_path}/s\\xe9.h5 sha256 {sha256_file(store)}" in text
+        assert f"store: {tmp_path}/s\\xe9.h5 sha256 {file_sha256(store)}" in text
 
 
 @pytest.mark.usefixtures("undrawn_report_figures")
@@ -310,7 +310,7 @@ def test_one_dem_store_given_under_several_spellings_is_read_and_listed_once(tmp
     result = make_report([], out_dir=tmp_path / "r", dem_store=[dem_store, rel, link],
                          formats="csv")
     text = (tmp_path / "r" / "report.provenance.txt").read_text(encoding="utf-8")
-    digest = sha256_file(dem_store)
+    digest = file_sha256(dem_store)
     assert text.count(f"sha256 {digest}") == 1
     assert f"store: {dem_store} sha256 {digest}" in text  # the first spelling given
     alone = make_report([], out_dir=tmp_path / "r1", dem_store=dem_store, formats="csv")
@@ -446,13 +446,13 @@ def test_the_load_case_table_a_report_read_is_listed_with_its_hash(tmp_path, dem
     make_report([file], out_dir=tmp_path / "r", dem_store=dem_store, formats="csv",
                 sidecar=table)
     text = (tmp_path / "r" / "report.provenance.txt").read_text(encoding="utf-8")
-    assert f"input: cases.csv sha256 {sha256_file(table)}" in text
+    assert f"input: cases.csv sha256 {file_sha256(table)}" in text
     # one beside the files, read by default, is listed as well
     beside = tmp_path / "loadcases.csv"
     beside.write_text("file,fill_percent\ncoupon1.csv,50\n", encoding="utf-8")
     make_report([file], out_dir=tmp_path / "r2", dem_store=dem_store, formats="csv")
     text = (tmp_path / "r2" / "report.provenance.txt").read_text(encoding="utf-8")
-    assert f"input: loadcases.csv sha256 {sha256_file(beside)}" in text
+    assert f"input: loadcases.csv sha256 {file_sha256(beside)}" in text
 
 
 @pytest.mark.usefixtures("undrawn_report_figures")

@@ -21,7 +21,6 @@ from pidcore.report import (
     build_report_table,
     collect_provenance,
     parse_formats,
-    sha256_file,
     write_report,
 )
 
@@ -92,14 +91,6 @@ def test_provenance_footer_in_every_text_format(report, provenance):
         assert INPUT_SHA in text and store_sha in text, name
         assert "2026-01-02T03:04:05+00:00" in text and "seeds: 1, 3" in text
         assert f"numpy {np.__version__}" in text
-
-
-def test_store_hash_is_the_files_sha256(provenance, tmp_path):
-    import hashlib
-
-    path = tmp_path / "x.bin"
-    path.write_bytes(b"abc" * 1000)
-    assert sha256_file(path, chunk_bytes=7) == hashlib.sha256(b"abc" * 1000).hexdigest()
 
 
 def test_markdown_table_shape(report, table):

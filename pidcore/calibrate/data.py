@@ -33,8 +33,7 @@ from ..compare.plausibility import (
     stored_record_name,
 )
 from ..errors import InputFileError, ParameterError, as_given, real_number
-from ..io import display_path
-from ..io._common import file_sha256
+from ..io import display_path, file_sha256
 from ..loadcase import normalize_material
 
 if TYPE_CHECKING:  # pragma: no cover

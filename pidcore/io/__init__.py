@@ -33,6 +33,8 @@ assign_roles, RoleAssignment, name_suggests
     Which channels are force, velocity and acceleration (units, then names).
 display_path
     A path as printable text (undecodable bytes escaped).
+file_sha256
+    SHA-256 of a file's bytes (a measurement's ``sha256``, a report's input and store hashes).
 
 Examples
 --------
@@ -54,7 +56,7 @@ from ..constants import FileFormat
 from ..errors import InputFileError, ParameterError, PidcoreError, instance_of
 from ..records import Measurement
 from ..units import given_time_unit
-from ._common import HDF5_SIGNATURE, reraise_interrupt
+from ._common import HDF5_SIGNATURE, file_sha256, reraise_interrupt
 from .delimited import read_csv, write_csv
 from .hdf5 import hdf5_key_sources, hdf5_keys, read_hdf5, write_hdf5
 from .matlab import read_mat, write_mat
@@ -63,7 +65,7 @@ from .uff import read_uff, write_uff
 
 __all__ = [
     "EMPTY_MEASUREMENT_FILE", "FILE_FORMAT_EXTENSIONS", "RoleAssignment", "assign_roles",
-    "detect_file_format", "display_path",
+    "detect_file_format", "display_path", "file_sha256",
     "hdf5_keys", "name_suggests", "read_csv", "read_hdf5", "read_mat", "read_measurement",
     "read_measurements", "read_uff", "write_csv", "write_hdf5", "write_mat",
     "write_measurement", "write_uff",

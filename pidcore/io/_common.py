@@ -41,12 +41,13 @@ def reraise_interrupt(exc: BaseException) -> None:
     interrupt.raise_if_interrupted()  # converted without a chain: the SIGINT flag still says so
 
 
-def file_sha256(path: str | os.PathLike[str]) -> str:
-    """SHA-256 (hex) of a file's bytes, read in blocks."""
+def file_sha256(path: str | os.PathLike[str], *, chunk_bytes: int = 1 << 20) -> str:
+    """SHA-256 (hex) of a file's bytes, read ``chunk_bytes`` at a time (stores can be large):
+    the one hash of a file's content, for measurements, tables, stores and output records."""
     digest = hashlib.sha256()
     with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            digest.update(block)
+        while chunk := fh.read(chunk_bytes):
+            digest.update(chunk)
     return digest.hexdigest()
 
 

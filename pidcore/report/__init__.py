@@ -20,14 +20,15 @@ REPORT_COLUMNS_RENAMED
     Old column name -> new, for a report.csv of an earlier pidcore.
 write_report, parse_formats, RENDERERS, REPORT_MARKER
     The report files (CSV, Markdown, HTML, LaTeX, PDF).
-collect_provenance, Provenance, sha256_file
-    Versions, parameters, seeds and hashes behind a report.
+collect_provenance, Provenance
+    Versions, parameters, seeds and hashes behind a report (the hashes:
+    :func:`pidcore.io.file_sha256`).
 open_verified_store
     A store opened and verified (one-line error if corrupt).
 """
 
 from .pipeline import MeasuredResult, ReportResult, analyze_files, make_report, open_verified_store
-from .provenance import Provenance, collect_provenance, sha256_file
+from .provenance import Provenance, collect_provenance
 from .render import RENDERERS, REPORT_MARKER, parse_formats, write_report
 from .table import ALIGNMENT_COLUMN, REPORT_COLUMNS, REPORT_COLUMNS_RENAMED, build_report_table
 
@@ -35,5 +36,5 @@ __all__ = [
     "ALIGNMENT_COLUMN", "RENDERERS", "REPORT_COLUMNS", "REPORT_COLUMNS_RENAMED", "REPORT_MARKER",
     "MeasuredResult",
     "Provenance", "ReportResult", "analyze_files", "build_report_table", "collect_provenance",
-    "make_report", "open_verified_store", "parse_formats", "sha256_file", "write_report",
+    "make_report", "open_verified_store", "parse_formats", "write_report",
 ]

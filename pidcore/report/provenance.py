@@ -10,19 +10,10 @@ from datetime import UTC, datetime
 from importlib.metadata import PackageNotFoundError, version
 from pathlib import Path
 
-from ..io import display_path
+from ..io import display_path, file_sha256
 
 #: Packages whose versions every report lists.
 PROVENANCE_PACKAGES: tuple[str, ...] = ("numpy", "scipy", "numba", "pandas", "matplotlib", "h5py")
-
-
-def sha256_file(path: str | Path, *, chunk_bytes: int = 1 << 20) -> str:
-    """SHA-256 hex digest of a file's bytes, read in chunks (stores can be large)."""
-    digest = hashlib.sha256()
-    with open(path, "rb") as fh:
-        while chunk := fh.read(chunk_bytes):
-            digest.update(chunk)
-    return digest.hexdigest()
 
 
 def _package_version(name: str) -> str:
@@ -179,11 +170,11 @@ def collect_provenance(*, parameters: Mapping[str, object] | None = None,
     input_hashes = dict(input_hashes or {})
     hashed_inputs = []
     for path in inputs:
-        digest = input_hashes.get(str(path)) or sha256_file(path)
+        digest = input_hashes.get(str(path)) or file_sha256(path)
         hashed_inputs.append((display_path(Path(path).name), digest))
     # display_path: a store or note naming a file that is not UTF-8 failed the report's
     # write (UnicodeEncodeError: surrogates not allowed) after its analyses were saved
-    hashed_stores = tuple((display_path(p), sha256_file(p))
+    hashed_stores = tuple((display_path(p), file_sha256(p))
                           for p in dict.fromkeys(map(str, stores)))
     stamp = (created_utc or datetime.now(UTC)).astimezone(UTC)
     return Provenance(versions=versions, parameters=dict(parameters or {}),
@@ -210,7 +201,7 @@ def calibration_provenance(calibration) -> list[tuple[str, str, str]]:
     if calibration.document_text:
         digest = hashlib.sha256(calibration.document_text.encode("utf-8")).hexdigest()
     else:
-        digest = sha256_file(calibration.path)
+        digest = file_sha256(calibration.path)
     where = calibration_source(calibration)
     specimen = calibration.calibrated_specimen()
     if specimen is None:
