@@ -957,7 +957,7 @@ def test_figures_say_once_which_characters_they_could_not_draw(tmp_path, monkeyp
     terminal; one note names the character instead."""
     import warnings
 
-    from pidcore.report.fonts import installed_fallback_families
+    from pidcore.plot_text import installed_fallback_families
 
     mine = _specimen_runs("сталь_6мм_鋼", "a" * 64, coupon_kg=0.05, fixture_kg=0.12,
                           sdc_scale=0.5)

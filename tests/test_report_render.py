@@ -1071,7 +1071,7 @@ def test_report_says_once_which_characters_its_figures_could_not_draw(tmp_path, 
 
     import pidcore.report.pipeline as pipeline
     from pidcore.cli import main
-    from pidcore.report.fonts import installed_fallback_families
+    from pidcore.plot_text import installed_fallback_families
 
     table = _two_settings_table()
     table["specimen"] = ["сталь_6мм_鋼", "steel_6mm", "сталь_6мм_鋼"]

@@ -29,6 +29,7 @@ from .. import defaults
 from ..constants import REPORT_FORMATS
 from ..errors import ParameterError
 from ..out_folder import check_replaceable, restore_previous, write_folder_whole
+from ..plot_text import text_as_typed
 from ..units import value_and_error_texts
 from .provenance import Provenance
 from .table import (
@@ -617,6 +618,7 @@ def _pdf_height(row: list[str], mark: str, notes: list[str], listed: set[str]) -
     return height
 
 
+@text_as_typed  # its pages' text too: a specimen's CJK name in the table
 def _write_pdf(table: pd.DataFrame, figures: Mapping[str, Path], prov: Provenance,
                folder: Path, *, figure_objects: Mapping[str, object] | None = None) -> Path:
     import matplotlib.pyplot as plt
