@@ -155,6 +155,7 @@ from .constants import (
     FILL_REFERENCES,
     TANGENTIAL_STIFFNESS_MODELS,
     CellShape,
+    ImpactPair,
     NormalDampingMode,
     TangentialStiffnessModel,
 )
@@ -1948,7 +1949,6 @@ def describe(specimen: Specimen, *,
     from . import defaults
     from .constants import PARTICLE_MATERIALS
     from .dem.contact import check_damping_mode, maximum_overlap
-    from .dem.impact import measure_restitution
     from .dem.simulate import LoadCase, choose_time_step, max_impact_speed
     from .model.damper import specimen_area_m2
 
@@ -1979,8 +1979,7 @@ def describe(specimen: Specimen, *,
     dt = choose_time_step(case, law, geometry, "auto", defaults.DEM_TANGENTIAL_MODEL)
     v_cal = defaults.DEM_CALIBRATION_SPEED_M_S
     stated = {"pp": law.pair_particle.restitution, "pw": law.pair_wall.restitution}
-    simulated = {name: measure_restitution(pair=pair, impact_speed_m_s=v_cal, dt_s=dt,
-                                           mode=mode, law=law, geometry=geometry)
+    simulated = {name: _simulated_restitution(specimen, pair, v_cal, dt, mode, law, geometry)
                  for name, pair in (("pp", "particle"), ("pw", "wall"))}
     return {
         "name": specimen.name, "sha256": specimen.hash, "is_paper": specimen.is_paper(),
@@ -2034,26 +2033,58 @@ def describe(specimen: Specimen, *,
     }
 
 
+def _simulated_restitution(specimen: Specimen, pair: ImpactPair, speed_m_s: float, dt_s: float,
+                           mode: NormalDampingMode, law: ContactLaw,
+                           geometry: CellGeometry) -> float:
+    """The restitution of :func:`describe`'s head-on impact, an impact that does not end
+    refused naming the file and the key: "particle still in contact", naming neither, was
+    all `specimen check` said."""
+    from .dem.impact import StillInContact, measure_restitution, pair_name
+
+    try:
+        return measure_restitution(pair=pair, impact_speed_m_s=speed_m_s, dt_s=dt_s,
+                                   mode=mode, law=law, geometry=geometry)
+    except StillInContact as exc:
+        key = f"pairs.{'particle_wall' if pair == 'wall' else 'particle_particle'}.restitution"
+        pair_law = law.pair_wall if pair == "wall" else law.pair_particle
+        raise ParameterError(
+            f"{specimen.source}: {key} {pair_law.restitution:g}: the {pair_name(pair)} impact "
+            f"with Eq. 3's alpha {pair_law.alpha:.4g} in {mode} damping has not rebounded "
+            f"({exc}), so the kernel gives it no restitution; expected a larger restitution"
+            + (", or normal_damping_mode='no_attraction'" if mode == "literal" else "")
+        ) from None
+
+
 def restitution_note(stated: dict[str, float], simulated: dict[str, float],
                      mode: NormalDampingMode) -> tuple[str, ...]:
     """A note naming the pairs (``"pp"``, ``"pw"``) whose head-on impact through the kernel
     gives a restitution more than RESTITUTION_NOTE_GAP from the stated one, and the options
     that give the stated value: a run with Eq. 3's alpha simulates a livelier bed than the
-    file says, and nothing else said so."""
+    file says, and nothing else said so. And one naming the pairs whose impact gains energy
+    (a restitution more than RESTITUTION_GAIN_NOTE above 1): 1.001 for e = 1 was printed
+    without a word."""
     from . import defaults
 
     names = {"pp": "particle-particle", "pw": "particle-wall"}
+    notes = []
     off = [f"{names[k]} {simulated[k]:.3f} for the stated {stated[k]:g}" for k in names
            if abs(simulated[k] - stated[k]) > defaults.RESTITUTION_NOTE_GAP]
-    if not off:
-        return ()
-    cures = "damping_coefficient='calibrated' (DemConfig) tunes alpha to give the stated value"
-    if mode != "literal":
-        cures += (", or normal_damping_mode='literal' (Eq. 3's alpha is exact for damping that "
-                  "may pull at the contact's end)")
-    return (f"restitution in {mode} damping mode with Eq. 3's alpha: the kernel gives "
-            f"{', '.join(off)} (head-on at {defaults.DEM_CALIBRATION_SPEED_M_S:g} m/s); "
-            f"{cures}",)
+    if off:
+        cures = ("damping_coefficient='calibrated' (DemConfig) tunes alpha to give the stated "
+                 "value")
+        if mode != "literal":
+            cures += (", or normal_damping_mode='literal' (Eq. 3's alpha is exact for damping "
+                      "that may pull at the contact's end)")
+        notes.append(f"restitution in {mode} damping mode with Eq. 3's alpha: the kernel gives "
+                     f"{', '.join(off)} (head-on at "
+                     f"{defaults.DEM_CALIBRATION_SPEED_M_S:g} m/s); {cures}")
+    gains = [f"{names[k]} {simulated[k]:.4f} ({simulated[k] ** 2 - 1:.2%} of its kinetic "
+             "energy)" for k in names if simulated[k] > 1 + defaults.RESTITUTION_GAIN_NOTE]
+    if gains:
+        notes.append(f"restitution above 1: each head-on impact gains energy, "
+                     f"{', '.join(gains)}: the explicit time step's error, which a shorter "
+                     "time step lowers; no damping setting removes it")
+    return tuple(notes)
 
 
 #: A fixture this many times the coupon (its particles left out) is named in `specimen

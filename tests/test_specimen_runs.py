@@ -647,6 +647,67 @@ def test_specimen_check_says_the_restitution_the_kernel_gives_and_how_to_get_the
     assert "note: restitution" not in out
 
 
+def test_specimen_check_names_an_impact_that_gains_energy(capsys, tmp_path):
+    """e = 1 gave a simulated particle-particle restitution of 1.001 (an impact that gains
+    energy, the step's error) without a note: within the 0.01 of the stated 1."""
+    path = tmp_path / "carbide_elastic.toml"  # 1.5 mm carbide beads in 1/8 in cells
+    path.write_text(load_specimen(STEEL).with_values(
+        {"particles.material": "tungsten_carbide", "particles.radius_m": 0.75e-3,
+         "particles.density_kg_m3": 15600.0, "particles.youngs_modulus_pa": 600e9,
+         "particles.poisson_ratio": 0.22, "cell.inscribed_diameter_m": 3.175e-3,
+         "cell.height_m": 10e-3, "pairs.particle_particle.restitution": 1.0,
+         "pairs.particle_wall.restitution": 1.0}).to_toml())
+    assert main(["specimen", "check", str(path), "--json"]) == 0
+    facts = json.loads(capsys.readouterr().out)
+    simulated = facts["restitution_pp_simulated"]
+    # 1.0011 at 10 steps per (pair) contact: the explicit step's energy error
+    assert simulated > 1 + defaults.RESTITUTION_GAIN_NOTE
+    (note,) = [n for n in facts["notes"] if n.startswith("restitution above 1")]
+    assert f"particle-particle {simulated:.4f} ({simulated**2 - 1:.2%} of its kinetic" in note
+    # the wall contact, longer, has more steps: 1.0002, shown as 1, and not named
+    assert facts["restitution_pw_simulated"] < 1 + defaults.RESTITUTION_GAIN_NOTE
+    assert "particle-wall" not in note
+
+
+def test_an_impact_that_does_not_rebound_is_refused_by_specimen_check_naming_file_and_key(
+        capsys, tmp_path):
+    """"error: impact: particle still in contact after 3 contact times" named neither file
+    nor key nor what to change."""
+    path = tmp_path / "steel_dead.toml"
+    path.write_text(load_specimen(STEEL).with_values(
+        {"pairs.particle_wall.restitution": 0.001}).to_toml())
+    # Eq. 3's damping of e 0.001 holds the sphere on the wall past 3 contact times when it
+    # may pull (literal); clipped, it leaves
+    assert main(["specimen", "check", str(path), "--damping-mode", "literal"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1
+    assert str(path.name) in err and "pairs.particle_wall.restitution 0.001" in err
+    assert "particle-wall impact" in err and "expected a larger restitution" in err
+
+
+def test_a_calibrated_run_on_a_soft_wall_states_the_alpha_that_gives_the_stated_e(
+        capsys, tmp_path):
+    """Steel on a Nomex wall: `dem run --damping-coefficient calibrated` ended in brentq's
+    traceback at 500 Hz / 5 g (the wall impact's run was cut before its rebound)."""
+    from _hertz_tsuji import hertz_tsuji_restitution
+
+    path = tmp_path / "steel_nomex.toml"
+    specimen = load_specimen(STEEL).with_values(
+        {"cell.wall_material": "nomex", "cell.wall_youngs_modulus_pa": 3.4e9,
+         "cell.wall_poisson_ratio": 0.3, "cell.wall_density_kg_m3": 1400.0})
+    path.write_text(specimen.to_toml())
+    assert main(["dem", "run", "--specimen", str(path), "--frequency", "500",
+                 "--acceleration", "5", "--cells", "1", "--cycles", "4",
+                 "--damping-coefficient", "calibrated", "--store", str(tmp_path / "r.h5"),
+                 "--no-progress", "--json"]) == 0
+    doc = json.loads(capsys.readouterr().out)
+    wall = contact_law(specimen).pair_wall
+    # the run's step gives the 4.5 x longer wall contact ~45 steps: the step's error in e is
+    # ~0.002 there (first order, 0.006 at 20 steps); 0.01 holds it
+    assert hertz_tsuji_restitution(wall.stiffness, wall.effective_mass_kg, doc["alpha_pw"],
+                                   0.3) == pytest.approx(0.8, abs=0.01)
+
+
 def test_a_sweeps_json_and_summary_name_each_runs_specimen_file(capsys, tmp_path):
     """`dem sweep --json` gave per case its load case and results but not whose run it was:
     the sweeps of two files named x (the second an edit of the first) into one store read

@@ -293,8 +293,8 @@ def calibrated_contact_law(specimen: Specimen, config: DemConfig, dt_s: float) -
                 geometry=geometry,
                 law=lambda a: contact_law(specimen, alpha_pp=a, alpha_pw=config.alpha_pw)))
     except ParameterError as exc:  # which file's restitution, and which setting asked
-        raise ParameterError(f"damping_coefficient='calibrated', specimen {specimen.name!r}: "
-                             f"{exc}") from None
+        raise ParameterError(f"damping_coefficient='calibrated', specimen {specimen.name!r} "
+                             f"({specimen.source}): {exc}") from None
 
 
 def particles_per_cell(fill_percent: float, material_name: str | None = None, *,
