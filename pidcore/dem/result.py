@@ -229,6 +229,8 @@ class DemResult:
           (:func:`pidcore.dem.simulate._steady_by_scatter`), not by the block rule;
         * the run did not converge: the share of the dissipation the bed released from its
           stored energy over the window measured, and what that drift does to the SDC;
+        * the energy balance closes worse than DEM_ENERGY_BALANCE_LIMIT: the energy left
+          unaccounted for as an SDC, and whether the SDC is 0 to within it or not sound;
         * ``particle_steps_per_s`` was not measured (NaN): every kernel call compiled code;
         * a property of the specimen overrides its table material's
           (:func:`pidcore.specimen.table_overrides`);
@@ -282,6 +284,7 @@ class DemResult:
                 f"dissipated per cycle): if that is a drift, the SDC is {released:+.1%} off "
                 "the one the walls' work gives; where particles fly it is mostly noise "
                 "(docs/calibration.md, 'DEM runs that never reach a steady state')")
+        notes += self._balance_note()
         if not math.isfinite(self.particle_steps_per_s):
             notes.append("particle_steps_per_s not measured: every kernel call of this run "
                          "included Numba compilation (run again for the compiled speed)")
@@ -445,6 +448,31 @@ class DemResult:
         frame.attrs.update(case_key=self.case.key, sdc=self.sdc, sdc_stderr=self.sdc_stderr,
                            sample_rate_hz=self.sample_rate_hz)
         return frame
+
+    def _balance_note(self) -> list[str]:
+        """A note where the energy balance closes worse than DEM_ENERGY_BALANCE_LIMIT: the
+        energy left unaccounted for, as an SDC (spread over the cycles driven, scaled to the
+        coupon as the SDC is), says whether the SDC is unsound or only 0 to within it (a bed
+        that barely moves closes 1e-14 J to 77 %, and "closure error 77.30%" stood beside its
+        SDC without a word)."""
+        error = self.energy_balance_error
+        if not (math.isfinite(error) and abs(error) > defaults.DEM_ENERGY_BALANCE_LIMIT):
+            return []
+        unaccounted = self.work_walls_j - self.mechanical_energy_change_j \
+            - self.dissipated_total_j
+        cycles = np.shape(self.dissipation_per_cell_cycle_j)[-1]
+        scale = self.cells_simulated * cycles * self.max_kinetic_energy_j
+        as_sdc = abs(unaccounted) * self.coupon_cells / scale if scale > 0 else math.inf
+        said = (f"energy balance closure error {error:.2%}, above the "
+                f"{defaults.DEM_ENERGY_BALANCE_LIMIT:.0%} limit: {abs(unaccounted):.3g} J of "
+                f"the walls' work ({self.work_walls_j:.3g} J over the run) is neither stored "
+                f"in the bed nor dissipated, as much as an SDC of {as_sdc:.3g} over the "
+                f"{cycles} cycles driven")
+        if as_sdc < defaults.DEM_NEGLIGIBLE_SDC:
+            return [f"{said}: the SDC {self.sdc:.3g} is 0 to within that (the bed barely "
+                    "moves at this drive), not a measured damping"]
+        return [f"{said}: the SDC {self.sdc:.4g} is not sound; a shorter time step "
+                "closes the balance"]
 
     def _batches_agree(self) -> bool:
         """Whether the batch means of cell 0's steady SDC per cycle agree
