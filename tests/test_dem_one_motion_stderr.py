@@ -14,7 +14,7 @@ import pytest
 
 from pidcore.cli.dem import format_summary
 from pidcore.compare.align import dem_cases
-from pidcore.dem.contact import ContactLaw
+from pidcore.dem.contact import ContactLaw, damping_constant_from_restitution
 from pidcore.dem.persist import load_dem_result, save_dem_result
 from pidcore.dem.result import DemResult, batch_means_agree, batch_means_stderr
 from pidcore.dem.simulate import DemConfig, simulate_load_case
@@ -87,6 +87,21 @@ def test_cells_of_one_motion_get_the_batch_means_error_of_their_window():
     # such a run stored before batch means existed (no error kept) is not said to be short
     older = dataclasses.replace(result, sdc_stderr=math.nan, sdc_stderr_dof=math.nan)
     assert any("stored before pidcore took one from batches" in n for n in older.notes)
+
+
+@pytest.mark.parametrize("cells", [1, 2])
+def test_cells_that_dissipate_nothing_are_not_said_to_run_one_motion(cells):
+    """Five elastic frictionless spheres per cell were said to be "the same motion (the same
+    SDC to the last bit ...)": their cells only shared an SDC of 0."""
+    result = _from_tally(np.zeros((cells, 10)), transient=4, block_cycles=2)
+    assert result.sdc == 0.0 and math.isnan(result.sdc_stderr)
+    notes = " ".join(result.notes)
+    assert "same motion" not in notes and "one motion" not in notes
+    assert "dissipated nothing (an SDC of exactly 0" in notes
+    # and the damping constant of e = 1 is 0, not "-0"
+    elastic = dataclasses.replace(result, alpha_pp=damping_constant_from_restitution(1.0),
+                                  alpha_pw=damping_constant_from_restitution(1.0))
+    assert "alpha of Eq. 2 0 particle-particle, 0 particle-wall" in format_summary(elastic)
 
 
 def test_cells_that_differ_keep_their_scatter_bit_for_bit():

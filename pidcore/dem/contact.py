@@ -95,6 +95,8 @@ def damping_constant_from_restitution(restitution: float) -> float:
     """
     if not 0.0 < restitution <= 1.0:
         raise ParameterError(f"normal_restitution: expected 0 < e <= 1, got {restitution}")
+    if restitution == 1.0:  # -ln(1) is -0.0: a run of elastic contacts printed "alpha -0"
+        return 0.0
     ln_e = np.log(restitution)
     return float(-ln_e * np.sqrt(5.0 / (ln_e**2 + np.pi**2)))
 

@@ -297,7 +297,16 @@ class DemResult:
             if overridden:
                 notes.append(f"{overridden}: {self.particles_per_cell} particles per cell "
                              "simulated")
-        if stderr_from_batches(self.sdc_per_cell):
+        if stderr_from_batches(self.sdc_per_cell) and not np.any(self.sdc_per_cell):
+            # an SDC of exactly 0 in every cell says nothing of their motions being one (5
+            # elastic frictionless spheres were said to be "the same SDC to the last bit")
+            notes.append(
+                "no standard error: "
+                + ("its one cell" if self.cells_simulated == 1 else
+                   f"each of the {self.cells_simulated} cells")
+                + " dissipated nothing (an SDC of exactly 0: no contact dissipates, as with "
+                "elastic frictionless contacts), so there is no scatter to take an error from")
+        elif stderr_from_batches(self.sdc_per_cell):
             same = ("its one cell is one motion, with no second cell to scatter against"
                     if self.cells_simulated == 1 else
                     f"the {self.cells_simulated} cells ran the same motion (the same SDC to "
