@@ -28,6 +28,8 @@ whole_number, real_number, instance_of, as_given
     The checks of a value's type, and a number shown as the user gave it.
 clipped
     A value quoted in a message, whole where short, else by its start and its size.
+listed
+    Names listed in a message, the first few and how many more.
 outside_user_names
     A message rewritten everywhere but in the names the user gave.
 KEYWORD_NOT_BEFORE, KEYWORD_NOT_AFTER_WORD
@@ -130,6 +132,19 @@ def clipped(text: str, most: int = MAX_SHOWN_CHARS) -> str:
     if len(text) <= most:
         return text
     return f"{text[:max(most - 20, 1)]}... ({len(text)} characters)"
+
+
+#: Most names a message lists before it counts the rest: a MAT matrix read the wrong way
+#: round was thousands of channels, and the "one-line" error naming them 173 kB.
+MAX_LISTED_NAMES = 12
+
+
+def listed(names: Iterable[object], most: int = MAX_LISTED_NAMES) -> str:
+    """``'Force', 'Velocity'``: the names quoted (each :func:`clipped`), the first ``most``
+    and how many more (``'Signal 1.1', 'Signal 1.2' and 10228 more``); ``"none"`` for none."""
+    names = list(names)
+    shown = ", ".join(clipped(repr(n)) for n in names[:most])
+    return (shown + (f" and {len(names) - most} more" if len(names) > most else "")) or "none"
 
 
 def whole_number(name: str, value: object) -> int:
@@ -241,4 +256,4 @@ KEYWORD_NOT_AFTER_WORD = r"(?![\w'])(?! column)"
 __all__ = ["ChannelError", "DependencyError", "InputFileError", "KEYWORD_NOT_AFTER_WORD",
            "KEYWORD_NOT_BEFORE", "ParameterError", "PidcoreError",
            "SettingsTableError", "SignalError", "SimulationError", "StoreError", "as_given",
-           "clipped", "instance_of", "outside_user_names", "real_number", "whole_number"]
+           "clipped", "instance_of", "listed", "outside_user_names", "real_number", "whole_number"]

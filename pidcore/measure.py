@@ -52,6 +52,7 @@ from .errors import (
     a_or_an,
     as_given,
     instance_of,
+    listed,
 )
 from .io import assign_roles, read_measurement
 from .records import Channel, Measurement
@@ -295,7 +296,7 @@ def _align(channels: dict[str, Channel], source: str, notes: list[str],
     first = max(shift.values())
     last = min(shift[r] + lengths[r] for r in channels)
     if last - first < 8:
-        names = ", ".join(repr(c.name) for c in channels.values())
+        names = listed(c.name for c in channels.values())
         raise ChannelError(f"{source}: the channels {names} do not overlap in time (start times "
                            f"{', '.join(f'{s:.6g} s' for s in starts.values())})")
     out = {}
@@ -384,7 +385,7 @@ def _invert(measurement: Measurement, names: Sequence[str], notes: list[str]) ->
     for name in names:
         if name not in known:
             raise ChannelError(f"{measurement.source}: invert={name!r}: no such channel; "
-                               f"channels are {', '.join(repr(n) for n in known)}")
+                               f"channels are {listed(known)}")
     channels = tuple(replace(c, data=-np.asarray(c.data)) if c.name in names else c
                      for c in measurement.channels)
     notes.extend(f"channel {n!r} inverted (invert={n!r})" for n in names)
@@ -500,7 +501,7 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
     motion = _motion_role(chosen)
     if roles.ignored:
         notes.append("ignored channels (not needed): "
-                     + ", ".join(repr(n) for n in roles.ignored))
+                     + listed(roles.ignored))
         corrections["ignored_channels"] = list(roles.ignored)
     try:
         analysis = analyze_channels(

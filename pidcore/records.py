@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .constants import SI_UNITS
-from .errors import ChannelError, StoreError
+from .errors import ChannelError, StoreError, listed
 
 if TYPE_CHECKING:  # pragma: no cover
     import pandas as pd
@@ -113,8 +113,8 @@ class Measurement:
         for ch in self.channels:
             if ch.name == name:
                 return ch
-        names = ", ".join(repr(c.name) for c in self.channels) or "none"
-        raise ChannelError(f"{self.source}: no channel named {name!r}; channels are {names}")
+        raise ChannelError(f"{self.source}: no channel named {name!r}; channels are "
+                           f"{listed(c.name for c in self.channels)}")
 
     @property
     def channel_names(self) -> list[str]:

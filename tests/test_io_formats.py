@@ -473,6 +473,26 @@ def _testlab_mat(path, *signals: dict):
     return path
 
 
+@pytest.mark.parametrize("names", [["Force", "Velocity"], None])
+def test_mat_lms_testlab_channels_stored_as_rows_without_a_sample_count_are_channels(
+        tmp_path, names):
+    """A Signal of 2 x 10240 values and no x_values.number_of_values was read as 10240
+    channels of 2 samples (and refused in a 173 kB line): the names' count, else the longer
+    axis (samples outnumber channels), says where the channels lie. Read back bit for bit."""
+    n, rate = 10240, 5120.0
+    rows = np.vstack([np.sin(np.arange(n) / 7.0), np.cos(np.arange(n) / 7.0)])
+    signal = {"x_values": {"start_value": 0.0, "increment": 1 / rate},
+              "y_values": {"values": rows, "quantity": {"label": "N"}}}
+    if names is not None:
+        signal["function_record"] = {"name": np.array(names, dtype=object)}
+    path = tmp_path / "rows.mat"
+    scipy.io.savemat(path, {"Signal": signal})
+    m = read_measurement(path)
+    assert m.channel_names == (names or ["Signal 1.1", "Signal 1.2"])
+    for ch, row in zip(m.channels, rows, strict=True):
+        assert ch.n_samples == n and np.array_equal(ch.data, row)
+
+
 def test_mat_lms_testlab_values_stored_in_si_and_shown_in_g_are_read_in_si_and_said(tmp_path):
     # Test.Lab stores SI and shows the label's unit, display = SI x factor: read as g, the
     # acceleration was 9.8 x too large (49 g for 5 g), silently

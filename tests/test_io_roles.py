@@ -137,3 +137,18 @@ def test_missing_force_reported_before_motion_ambiguity():
     m = _m(_ch("1+Z", "acceleration", "m/s2"), _ch("2+Z", "acceleration", "m/s2"))
     with pytest.raises(ChannelError, match="no force channel"):
         assign_roles(m)
+
+
+def test_a_refusal_naming_thousands_of_channels_lists_a_few_and_counts_the_rest():
+    """A MAT matrix read the wrong way round was 10240 channels, and the "one-line" refusal
+    listing them was 173 kB: the first 12 are named and the rest counted, so the line stays
+    under 12 names of at most 80 characters (about 1 kB with the words around them)."""
+    many = _m(*(_ch(f"Signal 1.{i + 1}", "pressure", "Pa") for i in range(10240)))
+    with pytest.raises(ChannelError) as err:
+        assign_roles(many)
+    message = str(err.value)
+    assert "'Signal 1.12' and 10228 more" in message and "'Signal 1.13'" not in message
+    assert len(message) < 1500
+    few = _m(_ch("Mic", "pressure", "Pa"), _ch("Temp", "temperature", "K"))
+    with pytest.raises(ChannelError, match=r"among 'Mic', 'Temp'[;( ]"):
+        assign_roles(few)  # a short list stays whole

@@ -39,7 +39,7 @@ import numpy as np
 import pandas as pd
 
 from ..atomic_files import atomic_path
-from ..errors import InputFileError, ParameterError, a_or_an, clipped
+from ..errors import InputFileError, ParameterError, a_or_an, clipped, listed
 from ..records import Measurement
 from ..units import (
     UnitReading,
@@ -739,7 +739,7 @@ def _pair_time_bases(columns: list[np.ndarray], cells: list[tuple[str, str]],
             continue
         for i in owned:
             bases[i] = base
-        channels = ", ".join(repr(names[keep.index(i)]) for i in owned)
+        channels = listed(names[keep.index(i)] for i in owned)
         notes.append(f"{where}: column {name!r} is the time of {channels}: "
                      f"{base[2]} samples from {base[1]:.9g} s at {base[0]:.9g} Hz "
                      f"(the first time column: {main[2]} from {main[1]:.9g} s at "

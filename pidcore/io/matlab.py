@@ -46,7 +46,7 @@ import scipy.io
 
 from ..atomic_files import atomic_path
 from ..constants import SI_UNITS
-from ..errors import InputFileError, ParameterError
+from ..errors import InputFileError, ParameterError, listed
 from ..records import Channel, Measurement
 from ..units import (
     UnitReading,
@@ -420,6 +420,17 @@ def _lms_seconds_per_unit(x_values: Mapping, what: str, given: UnitReading | Non
                          "it with time_unit=UNIT")
 
 
+def _channels_in_rows(shape: tuple[int, int], n_names: int) -> bool:
+    """Whether a Test.Lab ``y_values.values`` matrix without ``number_of_values`` holds its
+    channels as rows: where ``function_record.name`` counts one axis only, that one; else
+    the shorter axis (a record holds more samples than channels). Read as columns, 2 x 10240
+    values were 10240 channels of 2 samples."""
+    rows, columns = shape
+    if (rows == n_names) != (columns == n_names):
+        return rows == n_names
+    return columns > rows
+
+
 def _lms_layout(signal: object, where: str, given_time: UnitReading | None = None,
                 notes: list[str] | None = None) -> list[Channel]:
     notes = [] if notes is None else notes
@@ -445,6 +456,11 @@ def _lms_layout(signal: object, where: str, given_time: UnitReading | None = Non
         seconds_per_unit = _lms_seconds_per_unit(x, what, given_time, notes)
         start, increment = start * seconds_per_unit, increment * seconds_per_unit
         values = values.reshape(values.shape[0], -1) if values.ndim > 1 else values[:, None]
+        record = sig.get("function_record", {})
+        given_names = [_text(v) for v in _as_list(record.get("name")
+                                                  if isinstance(record, Mapping) else None)]
+        if "number_of_values" not in x and _channels_in_rows(values.shape, len(given_names)):
+            values = values.T
         if "number_of_values" in x:
             n_given = real_scalar(x["number_of_values"], where=f"{what}: x_values.number_of_values",
                                   positive=True)
@@ -459,13 +475,10 @@ def _lms_layout(signal: object, where: str, given_time: UnitReading | None = Non
                 raise InputFileError(f"{what}: y_values holds {values.shape[0]} of "
                                      f"{n} samples; the file is truncated")
             values = values[:n]
-        record = sig.get("function_record", {})
-        given_names = [_text(v) for v in _as_list(record.get("name")
-                                                  if isinstance(record, Mapping) else None)]
         names = [given_names[j] if j < len(given_names) and given_names[j]
                  else f"Signal {k + 1}.{j + 1}" for j in range(values.shape[1])]
         unit = _lms_unit(y.get("quantity") if isinstance(y, Mapping) else None,
-                         f"{what} ({', '.join(map(repr, names))}): y_values", notes)
+                         f"{what} ({listed(names)}): y_values", notes)
         for j, name in enumerate(names):
             channels.append(make_channel(name, values[:, j], sample_rate_hz=1.0 / increment,
                                          unit=unit, start_time_s=start))
@@ -537,9 +550,9 @@ def _simple_layout(variables: Mapping, where: str, sample_rate_hz: float | None,
             left_out = [k for k in numeric if k not in vectors]
             raise InputFileError(
                 f"{where}: the cell 'units' holds {len(unit_list)} units for "
-                f"{len(vectors)} channel variables ({', '.join(map(repr, vectors)) or 'none'}"
+                f"{len(vectors)} channel variables ({listed(vectors)}"
                 + (f"; left out, of another length than {time_key!r}: "
-                   f"{', '.join(map(repr, left_out))}" if left_out else "")
+                   f"{listed(left_out)}" if left_out else "")
                 + "); expected one unit per channel variable, in their order, or a struct "
                 "'units' naming each channel (units.Force = 'N')")
         units = {k: (unit_list[i] if i < len(unit_list) else "")

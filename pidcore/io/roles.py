@@ -34,7 +34,7 @@ import re
 from collections.abc import Collection
 from dataclasses import dataclass
 
-from ..errors import ChannelError, a_or_an
+from ..errors import ChannelError, a_or_an, listed
 from ..records import Channel, Measurement
 from ..units import read_unit
 
@@ -143,7 +143,7 @@ def _misnamed_hint(measurement: Measurement, roles: tuple[str, ...],
 
 
 def _names(channels: list[Channel]) -> str:
-    return ", ".join(repr(c.name) for c in channels) or "none"
+    return listed(c.name for c in channels)
 
 
 def _candidates(measurement: Measurement, role: str, taken: set[str]) -> list[Channel]:
