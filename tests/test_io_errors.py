@@ -71,6 +71,66 @@ def test_csv_header_only_and_text_cells(tmp_path):
         read_measurement(words)
 
 
+def _sine_rows(fmt: str, sep: str = ",", decimal: str = ".") -> list[str]:
+    """300 rows of time, force and velocity of a 60 Hz sine at 1200 Hz, written with ``fmt``."""
+    t = np.arange(300) / 1200.0
+    w = 2 * np.pi * 60
+    return [sep.join((fmt % x).replace(".", decimal) for x in row)
+            for row in zip(t, 0.8 * np.sin(w * t), 0.07 * np.cos(w * t), strict=True)]
+
+
+@pytest.mark.parametrize(("fmt", "sep", "decimal", "cut", "said"), [
+    # the tester's file: '7.681693e-02' cut to '7.681693', a value 13 % of the record's SDC
+    ("%.6e", ",", ".", lambda row: row[:-4], "written shorter"),
+    ("%.6e", ";", ",", lambda row: row[:-4], "written shorter"),  # decimal comma
+    ("%.6e", ",", ".", lambda row: row[:-1], "2-digit exponent"),  # 'e-0'
+    ("%.6f", "\t", ".", lambda row: row[:-3], "6 decimals"),
+    ("%.9g", ",", ".", lambda row: row[:row.rindex(",")], "2 values where"),  # a field gone
+    ("%.9g", ",", ".", lambda row: row[:row.rindex(",") + 1], "2 values where"),
+])
+def test_a_csv_whose_last_row_is_cut_off_is_refused_naming_its_line(tmp_path, capsys, fmt, sep,
+                                                                     decimal, cut, said):
+    """An interrupted copy or export ends in a part of its last row, with no line break after
+    it: read as data, it took 13 % off an SDC with a standard error 5000 x smaller than that
+    and no word. Refused, naming the file and the line (the header is line 1, so the 300th
+    row is line 301); through the CLI one line, exit 2."""
+    rows = _sine_rows(fmt, sep, decimal)
+    path = tmp_path / "cut.csv"
+    path.write_text(sep.join(("Time [s]", "Force [N]", "Velocity [m/s]")) + "\n"
+                    + "\n".join(rows[:-1] + [cut(rows[-1])]))
+    with pytest.raises(InputFileError, match=rf"cut\.csv: line 301 is cut off: .*{said}"):
+        read_measurement(path)
+    from pidcore.cli import main
+
+    assert main(["analyze", str(path), "--no-store"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "cut.csv: line 301 is cut off" in err
+
+
+@pytest.mark.parametrize(("fmt", "last"), [
+    ("%.6e", None),  # a fixed format's whole last row
+    ("%.9g", "0.25"),  # a writer dropping trailing zeros: a last value shorter than the rows'
+    ("%.6f", "12.500000"),  # longer than the rows' (a larger value) is no cut
+    ("%.9g", ""),  # a channel ending early, its cells empty in the rows before too
+])
+def test_a_csv_lacking_only_its_final_line_break_reads_as_with_it(tmp_path, fmt, last):
+    """Many writers leave the last row without a line break: such a file reads to the same
+    numbers as with one (a complete last row is no cut, whatever its width)."""
+    rows = _sine_rows(fmt)
+    if last is not None:
+        cells = rows[-1].split(",")
+        rows[-1] = ",".join(cells[:-1] + [last])
+        if last == "":
+            rows[-3:] = [",".join(row.split(",")[:-1] + [""]) for row in rows[-3:]]
+    text = "Time [s],Force [N],Velocity [m/s]\n" + "\n".join(rows)
+    ended, open_ = tmp_path / "ended.csv", tmp_path / "open.csv"
+    ended.write_text(text + "\n")
+    open_.write_text(text)
+    for a, b in zip(read_measurement(ended).channels, read_measurement(open_).channels,
+                    strict=True):
+        assert np.array_equal(a.data, b.data) and a.sample_rate_hz == b.sample_rate_hz
+
+
 def test_mat_without_channels_lists_variables(tmp_path):
     import scipy.io
 
