@@ -396,10 +396,11 @@ def test_table_shows_a_missing_standard_error_as_na_not_nan(tmp_path, capsys):
     t = np.arange(int(40 * FS / FREQ)) / FS
     v = 0.01 * np.sin(w * t)
     x = -0.01 / w * np.cos(w * t)
-    # the first block (4 periods: 39 whole ones make 8 blocks of 4) a spring (Im < 0), then a
-    # mass with a damper; k = m w^2 gives the spring's force the mass's amplitude (a block
-    # whose line is weaker is refused as a dropout) and keeps the record's Im resolved
-    force = np.where(t < 4 / FREQ, MASS * w**2 * x,
+    # the first block (5 periods: 39 whole ones make 8 blocks of 4 or 5, the first of 5) a
+    # spring (Im < 0), then a mass with a damper; k = m w^2 gives the spring's force the
+    # mass's amplitude (a block whose line is weaker is refused as a dropout) and keeps the
+    # record's Im resolved
+    force = np.where(t < 5 / FREQ, MASS * w**2 * x,
                      MASS * 0.01 * w * np.cos(w * t) + C_VISCOUS * v)
     path = tmp_path / "spring_block.csv"
     write_force_velocity(path, force, v, FS, "csv")

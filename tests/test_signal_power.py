@@ -369,10 +369,10 @@ def test_blocks_shorter_than_the_fits_parameters_give_no_standard_error_not_a_cr
 
 
 def test_block_that_is_not_mass_like_gives_nan_with_note():
-    # 40 periods (39 whole at the estimated frequency) in 8 blocks of 4; the first 4 periods
-    # are a stiff spring (Im(P) < 0), the rest a mass with a damper, so the record as a whole
-    # is mass-like. The first block's loss factor is meaningless: the standard error must be
-    # refused, not computed over it.
+    # 40 periods (39 whole at the estimated frequency) in 8 blocks of 4 or 5 (the first 5);
+    # the first 5 periods are a stiff spring (Im(P) < 0), the rest a mass with a damper, so
+    # the record as a whole is mass-like. The first block's loss factor is meaningless: the
+    # standard error must be refused, not computed over it.
     # Block 1 has Im = -k v^2/(2 w) < 0 for any k; with k = m w^2 its force has the mass
     # blocks' amplitude (a block whose line is weaker is refused as a dropout:
     # test_a_channel_that_drops_out_in_one_block_is_refused_naming_it), and the whole record's
@@ -384,7 +384,7 @@ def test_block_that_is_not_mass_like_gives_nan_with_note():
     t = np.arange(int(40 * fs / f)) / fs
     v = 0.01 * np.sin(w * t)
     x = -0.01 / w * np.cos(w * t)
-    force = np.where(t < 4 / f, k * x, m * 0.01 * w * np.cos(w * t) + c * v)
+    force = np.where(t < 5 / f, k * x, m * 0.01 * w * np.cos(w * t) + c * v)
     res = analyze_power(force, v, fs, n_blocks=8)
     assert math.isnan(res.loss_factor_stderr) and math.isnan(res.sdc_stderr)
     assert "block 1 of 8" in res.uncertainty_note
@@ -689,7 +689,7 @@ def _swept_record(sweep: float, *, snr_db: float | None = None, seed: int = 0):
 
 @pytest.mark.parametrize("sweep, moved", [(0.003, "499.344 Hz in the first to 500.65"),
                                           (0.02, "495.625 Hz in the first to 504.375"),
-                                          (0.1, "478.1 Hz in the first to 521.5")])
+                                          (0.1, "478.125 Hz in the first to 521.85")])
 def test_a_drive_sweeping_over_the_record_is_refused_not_reported_low(sweep, moved):
     """A 0.3 % sweep gave 3.87 g for the true 5 g (the phasors of one fit at one frequency add
     the moving line incoherently) and 40 % of the energy per cycle, without a word; a 2 % one
@@ -794,10 +794,13 @@ def test_a_steady_drive_in_a_short_noisy_record_is_never_taken_for_a_sweep(fs, n
 
 
 def _block_fundamentals(v: np.ndarray, fs: float, frequency_hz: float, n_harm: int,
-                        periods_per_block: int, n_blocks: int = 8) -> np.ndarray:
+                        n_blocks: int = 8) -> np.ndarray:
     """The blocks' fundamentals by numpy's dense lstsq (DC, trend and ``n_harm`` harmonics at
-    the analysis' frequency, on the global sample index), the analysis' blocks."""
-    edges = np.round(np.arange(n_blocks + 1) * periods_per_block * fs / frequency_hz)
+    the analysis' frequency, on the global sample index), the analysis' blocks: the record's
+    whole periods shared out as evenly as they go, the last block to the record's end."""
+    whole = math.floor(v.size * frequency_hz / fs)
+    marks = np.round(np.arange(n_blocks) * whole / n_blocks)
+    edges = np.append(np.round(marks * fs / frequency_hz), v.size)
     theta = 2 * np.pi * frequency_hz / fs
     out = []
     for a, b in zip(edges[:-1].astype(int), edges[1:].astype(int), strict=True):
@@ -825,7 +828,7 @@ def test_a_phase_moving_between_one_period_blocks_is_said_in_degrees_not_in_thei
     res = analyze_power(force, v, fs)
     note = next(n for n in res.notes if n.startswith("drive frequency not quite stationary"))
     assert "Hz in the" not in note
-    blocks = _block_fundamentals(v, fs, res.frequency_hz, 5, 1)
+    blocks = _block_fundamentals(v, fs, res.frequency_hz, 5)
     span = np.ptp(np.degrees(np.angle(blocks * np.conj(blocks.mean()))))
     loss = 1 - abs(blocks.mean()) / np.abs(blocks).mean()
     assert f"phase spans {span:.3g} degrees over the 8 blocks" in note
@@ -851,7 +854,7 @@ def test_a_two_tone_beat_is_said_to_sum_below_its_blocks_not_to_lose_what_it_gai
         res = analyze_power(force, v, fs)
         said = next(n for n in res.notes if n.startswith("drive frequency not quite"))
         assert res.acceleration_amplitude_m_s2 > 1.02 * 5 * G  # no loss against 5 g
-        blocks = _block_fundamentals(v, fs, res.frequency_hz, 5, 125)
+        blocks = _block_fundamentals(v, fs, res.frequency_hz, 5)
         less = 1 - res.velocity_amplitude_m_s / np.abs(blocks).mean()
         assert f"has {100 * less:.3g} % less amplitude than they have on average" in said
     else:
@@ -933,3 +936,23 @@ def test_steady_records_and_a_slow_amplitude_ramp_are_not_taken_for_a_dropout(ra
         if not ramp:
             # 40 dB noise on 200 periods moves the energy per cycle by ~1e-3 at most
             assert res.energy_per_cycle_j == pytest.approx(energy, rel=5e-3)
+
+
+def test_a_glitch_in_the_records_last_periods_moves_its_standard_error_as_much_as_its_result():
+    """The blocks of the standard error were ``whole // 8`` periods each from the start: the
+    last up to 8 periods were in the record's fit only, and one sample 100 x there moved the
+    SDC 13 % while the standard error stayed 5000 x smaller. Every sample is in a block now.
+    One block of 8 off by 8 d (the others not) has a mean off by d and a standard error
+    sqrt(((7 d)^2 + 7 d^2) / 7 / 8) = d exactly: the shift lies at one standard error; 2 leaves
+    room for the block weighing 1/8 of the record only to a period and for the noise."""
+    fs, f, m, c = 10240.0, 100.0, 0.5, 3.0
+    rec = synthesize_shaker_record(mass_kg=m, acceleration_amplitude_m_s2=5 * G, frequency_hz=f,
+                                   sample_rate_hz=fs, n_periods=199.7,
+                                   viscous_damping_n_s_m=c, snr_db=40, seed=1)
+    clean = analyze_power(rec.force_n, rec.velocity_m_s, fs)
+    velocity = rec.velocity_m_s.copy()
+    velocity[-1] *= 100
+    glitched = analyze_power(rec.force_n, velocity, fs)
+    shift = abs(glitched.loss_factor - clean.loss_factor)
+    assert shift > 10 * clean.loss_factor_stderr  # the glitch matters
+    assert shift < 2 * glitched.loss_factor_stderr

@@ -561,7 +561,7 @@ def _check_stationary_drive(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
     moved = (f"the drive line's phase spans {np.ptp(phases):.3g} degrees over the "
              f"{fundamentals.size} blocks of the record")
     # a block's own frequency is known where it holds as many periods as a record must
-    block_periods = (edges[1] - edges[0]) * frequency_hz / sample_rate_hz
+    block_periods = int(np.min(np.diff(edges[:n_blocks + 1]))) * frequency_hz / sample_rate_hz
     if block_periods >= defaults.MIN_PERIODS:
         # each block's line found in its own spectrum: refined from the record's frequency, a
         # block a wide sweep had carried far from it settled on a wrong line (597.9 Hz for
@@ -644,6 +644,22 @@ def _check_block_amplitudes(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
     raise SignalError(f"{source or 'record'}: {'; '.join(said)}; "
                       f"{100 * defaults.DRIVE_COHERENCE_MAX_LOSS:g} % allowed: analyse a "
                       "stretch without those blocks")
+
+
+def _block_edges(whole: int, k_blocks: int, n_samples: int, sample_rate_hz: float,
+                 frequency_hz: float) -> np.ndarray:
+    """Sample edges of the ``k_blocks`` blocks of the standard error: whole periods, the
+    ``whole`` of the record shared out as evenly as they go (``whole // k_blocks`` or one
+    more each), the last block running to the record's end.
+
+    Every sample the record's fit uses is in a block, so whatever moves the result moves the
+    blocks' scatter too. Blocks of ``whole // k_blocks`` periods from the start left up to
+    ``k_blocks`` periods at the end in the record's fit only: a glitch there (one sample
+    100 x, a cut last row) moved the SDC 13 % while its standard error stayed 5000 x smaller
+    (docs/measurement.md)."""
+    marks = np.round(np.arange(k_blocks) * whole / k_blocks)
+    edges = np.round(marks * sample_rate_hz / frequency_hz).astype(np.int64)
+    return np.append(edges, n_samples)
 
 
 def _drift_knots(whole: int, n_samples: int, sample_rate_hz: float,
@@ -817,26 +833,21 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
     omega = 2 * np.pi * freq
     theta = omega / sample_rate_hz
 
-    # Blocks of whole periods for the standard error; the remainder (< K periods) is only in
-    # the global fit, which uses every sample.
     whole = int(math.floor(n_periods))
     k_blocks = int(n_blocks)
     if k_blocks >= 2 and whole >= k_blocks:
-        per_block = whole // k_blocks
-        edges = np.round(np.arange(k_blocks + 1) * per_block * sample_rate_hz / freq)
-        edges = np.append(edges.astype(np.int64), n_samples) if edges[-1] < n_samples else \
-            edges.astype(np.int64)
+        edges = _block_edges(whole, k_blocks, n_samples, sample_rate_hz, freq)
         uncertainty_note = ""
         # a block of fewer samples than the fit's parameters (harmonics, DC and trend) has no
         # phasors (NaN): one period of 11.6 samples at 5 harmonics holds 11 for 12
-        shortest = int(np.min(np.diff(edges[:k_blocks + 1])))
+        shortest = int(np.min(np.diff(edges)))
         n_params = fit_parameter_count(n_harm)
         if shortest < n_params:
             edges = np.array([0, n_samples], dtype=np.int64)
             uncertainty_note = (f"no standard error: blocks of {shortest} samples "
-                                f"({per_block} period(s) each of {k_blocks}) hold fewer than "
-                                f"the fit's {n_params} parameters ({n_harm} harmonics, DC "
-                                "and trend)")
+                                f"({whole // k_blocks} period(s) in the shortest of "
+                                f"{k_blocks}) hold fewer than the fit's {n_params} parameters "
+                                f"({n_harm} harmonics, DC and trend)")
             k_blocks = 0
     else:
         edges = np.array([0, n_samples], dtype=np.int64)
