@@ -248,6 +248,13 @@ def _half_unit(value: float, digits: int | None) -> float:
     return 0.5 * 10.0 ** (math.floor(math.log10(abs(value))) - digits + 1)
 
 
+def _printed_offset_uncertainty(start: float, force_start: float, digits: int | None) -> float:
+    """How far off, s, the offset of a start from the force's may be where the file prints
+    both with ``digits`` significant digits: half a unit of each (two starts printed alike
+    may lie that far apart)."""
+    return _half_unit(start, digits) + _half_unit(force_start, digits)
+
+
 def _motion_role(channels: Mapping[str, Channel]) -> str:
     """The role of the channel the velocity comes from: the velocity, or without one the
     acceleration it is integrated from."""
@@ -283,8 +290,8 @@ def _align(channels: dict[str, Channel], source: str, notes: list[str],
             continue
         # one start printed as the other is one clock reading: their offset is exact
         uncertainties[role] = (0.0 if starts[role] == force_start else
-                               _half_unit(starts[role], start_digits)
-                               + _half_unit(force_start, start_digits))
+                               _printed_offset_uncertainty(starts[role], force_start,
+                                                           start_digits))
         if abs(f) > 1e-6:
             # sampled f samples after the force's instants: the channel holds x(t + f/rate),
             # a delay of -f/rate in the convention of velocity_delay_s (x(t - tau)). The
@@ -344,6 +351,54 @@ def _check_start_offset_known(as_started: Mapping[str, Channel], chosen: Mapping
     correct: the motion channel's, whose phase error is the loss factor's, and the
     acceleration's that mass cancellation takes beside a velocity, whose phase error weighs
     in by :func:`_inertia_weight`. The two may add: their sum is held to the one budget."""
+    said, total = _start_offset_said(as_started, chosen, uncertainties_s, digits, analysis,
+                                     mass_below_gauge_kg)
+    if not said:
+        return
+    raise ChannelError(
+        f"{source}: {'; '.join(said)}, up to {total:.2g} off in the loss factor (expected "
+        f"within {MAX_START_OFFSET_PHASE_UNCERTAINTY_RAD:g}); export the channels with one "
+        "start time (one trigger), or in a format that states it finely (CSV time columns, "
+        "MAT, HDF5)")
+
+
+def _one_start_note(as_started: Mapping[str, Channel], chosen: Mapping[str, Channel],
+                    digits: int | None, analysis: PowerAnalysis,
+                    mass_below_gauge_kg: float) -> str:
+    """Say where channels printed with the force's start are taken as one clock reading
+    although that print could hide an offset beyond the budget of
+    :func:`_check_start_offset_known` ("" where it could not: a start of 0, or fine digits).
+
+    Channels exported from one acquisition share its trigger and print one start, which is
+    exact, and refusing them would refuse every Testlab export of a record that does not
+    start at 0; but records of two acquisitions 0.4 ms apart at 100 s print alike in E13.5
+    (1.00000e+02) and read a loss factor of 0.31 for 0.05. The assumption is said, with what
+    it would cost if it were wrong."""
+    force = as_started["force"]
+    # two starts printed alike may lie a unit of the last digit apart: the guard's rule
+    possible = {role: _printed_offset_uncertainty(ch.start_time_s, force.start_time_s, digits)
+                for role, ch in as_started.items()
+                if role != "force" and ch.start_time_s == force.start_time_s}
+    said, total = _start_offset_said(as_started, chosen, possible, digits, analysis,
+                                     mass_below_gauge_kg, printed_alike=True)
+    if not said:
+        return ""
+    return (f"{'; '.join(said)}; taken as one clock reading (one trigger, as one acquisition "
+            "exports its channels): had they started apart within that print, the loss factor "
+            f"would be up to {total:.2g} off (a start offset must be known to "
+            f"{MAX_START_OFFSET_PHASE_UNCERTAINTY_RAD:g}); if they come from different "
+            "acquisitions, export them in a format that states the start finely (CSV time "
+            "columns, MAT, HDF5)")
+
+
+def _start_offset_said(as_started: Mapping[str, Channel], chosen: Mapping[str, Channel],
+                       uncertainties_s: Mapping[str, float], digits: int | None,
+                       analysis: PowerAnalysis, mass_below_gauge_kg: float, *,
+                       printed_alike: bool = False) -> tuple[list[str], float]:
+    """Per channel, how far off its start offset against the force may be and what phase
+    that is, and the loss factor's uncertainty from them all; ``([], total)`` where that is
+    within :data:`MAX_START_OFFSET_PHASE_UNCERTAINTY_RAD`. ``printed_alike``: the starts
+    print as the force's (:func:`_one_start_note`)."""
     motion = _motion_role(chosen)
     weights = {motion: 1.0}
     if (motion == "velocity" and "acceleration" in chosen and mass_below_gauge_kg > 0
@@ -353,7 +408,7 @@ def _check_start_offset_known(as_started: Mapping[str, Channel], chosen: Mapping
     total = sum(weight * omega * uncertainties_s.get(role, 0.0)
                 for role, weight in weights.items())
     if not total > MAX_START_OFFSET_PHASE_UNCERTAINTY_RAD:
-        return
+        return [], total
     force = as_started["force"]
     rate = force.sample_rate_hz
     said = []
@@ -363,19 +418,18 @@ def _check_start_offset_known(as_started: Mapping[str, Channel], chosen: Mapping
             continue
         ch = as_started[role]
         phase = omega * uncertainty_s
-        said.append(
-            f"channel {ch.name!r} starts {(ch.start_time_s - force.start_time_s) * rate:+.4f} "
-            f"samples from channel {force.name!r} by the start times the file states with "
-            f"{digits} significant digits, known to ±{uncertainty_s * rate:.2g} samples only: "
-            f"{phase:.2g} rad at {analysis.frequency_hz:.6g} Hz"
-            + ("" if role == motion else
-               f" on the inertia force m a it cancels, weighed by m|A|/(|F| cos phi) = "
-               f"{weight:.2g}"))
-    raise ChannelError(
-        f"{source}: {'; '.join(said)}, up to {total:.2g} off in the loss factor (expected "
-        f"within {MAX_START_OFFSET_PHASE_UNCERTAINTY_RAD:g}); export the channels with one "
-        "start time (one trigger), or in a format that states it finely (CSV time columns, "
-        "MAT, HDF5)")
+        start = (f"channel {ch.name!r} states the start of channel {force.name!r}, "
+                 f"{ch.start_time_s:.6g} s, to {digits} significant digits, a print that "
+                 f"holds starts ±{uncertainty_s * rate:.2g} samples apart" if printed_alike else
+                 f"channel {ch.name!r} starts "
+                 f"{(ch.start_time_s - force.start_time_s) * rate:+.4f} samples from channel "
+                 f"{force.name!r} by the start times the file states with {digits} "
+                 f"significant digits, known to ±{uncertainty_s * rate:.2g} samples only")
+        said.append(f"{start}: {phase:.2g} rad at {analysis.frequency_hz:.6g} Hz"
+                    + ("" if role == motion else
+                       f" on the inertia force m a it cancels, weighed by m|A|/(|F| cos phi) "
+                       f"= {weight:.2g}"))
+    return said, total
 
 
 def _invert(measurement: Measurement, names: Sequence[str], notes: list[str]) -> Measurement:
@@ -528,6 +582,10 @@ def analyze_measurement(measurement: Measurement, options: AnalysisOptions | Non
         raise
     _check_start_offset_known(as_started, chosen, start_uncertainties_s, start_digits,
                               analysis, options.mass_below_gauge_kg, measurement.source)
+    one_start = _one_start_note(as_started, chosen, start_digits, analysis,
+                                options.mass_below_gauge_kg)
+    if one_start:
+        notes.append(one_start)
     notes.extend(_unit_slip_notes(measurement, chosen, analysis,
                                   mass_below_gauge_kg=options.mass_below_gauge_kg))
     if options.structure_mass_kg is not None and not options.baseline_loss_factor > 0:

@@ -337,6 +337,33 @@ def test_uff_records_of_one_start_are_one_clock_reading(tmp_path):
     assert analyze_file(path).analysis.loss_factor == pytest.approx(ETA, abs=1e-7)
 
 
+@pytest.mark.parametrize(("start_s", "said"), [(100.0, "±5.1 samples"), (0.05, None),
+                                               (0.0, None)])
+def test_one_start_printed_too_coarsely_to_rule_out_an_offset_is_said_as_one_clock_reading(
+        tmp_path, start_s, said):
+    """Records printed with one start are one clock reading (one acquisition's trigger), and
+    pass; but E13.5 prints 100 s and 100.0004 s alike, and records of two acquisitions that
+    far apart read a loss factor of 0.31 for 0.05 without a word. Where the print could hide
+    an offset beyond the guard's 1e-4 of the loss factor (two half units of 5e-4 s at 100 s:
+    5.1 samples at 5120 Hz, 0.63 rad at 100 Hz) the assumption is said; from 0.05 s (6.3e-5
+    rad) or 0 (exact) it is not."""
+    velocity_start = start_s + (4e-4 if said else 0.0)
+    response = _response("velocity", velocity_start * FS)
+    t_force = start_s + np.arange(N) / FS
+    path = tmp_path / "one_start.uff"
+    write_measurement(Measurement(path.name, (
+        Channel("Force", "force", _force(t_force), FS, "N", start_time_s=start_s),
+        response)), path)
+    record = analyze_file(path)
+    notes = [n for n in record.notes if "taken as one clock reading" in n]
+    if said is None:
+        assert notes == [] and record.analysis.loss_factor == pytest.approx(ETA, abs=1e-7)
+        return
+    (note,) = notes
+    assert "channel 'Velocity' states the start of channel 'Force', 100 s" in note
+    assert said in note and "0.63 rad at 100 Hz" in note and "up to 0.63 off" in note
+
+
 def test_a_start_offset_of_a_millionth_of_a_sample_is_said_as_it_is(tmp_path):
     # -3 samples at 5120 Hz (-5.859375e-4 s) is printed with six digits (E13.5) in the UFF:
     # the file states 2.6e-6 samples off the grid, which is corrected; the note said "starts
