@@ -94,7 +94,7 @@ BackgroundState = Literal["running", "done", "failed", "cancelled"]
 #: Whether a measured Eq. 11 SDC lies in the calibrated DEM's 95 % band (the report's column,
 #: the app's Compare page): "yes", "no", "not compared" (no band or no measurement to judge;
 #: not "n/a", which pandas.read_csv reads back as NaN), or "uninformative" (the band spans
-#: every plausible SDC, 0 .. the SDC bound, so it cannot test the model; not counted as inside).
+#: every plausible SDC, 0 .. 2 pi, so it cannot test the model; not counted as inside).
 BandVerdict = Literal["yes", "no", "not compared", "uninformative"]
 
 #: Particle materials in use for particle dampers that the material table does not hold: a

@@ -1139,7 +1139,7 @@ def test_compare_shows_the_calibrated_band_beside_raw_dem_and_measurement(
     if verdict == "uninformative":
         assert "calibrated 95 % band 0 .. 16.91 [-]" in captions  # as the sentence below
         assert ("the measured Eq. 11 SDC is uninformative: the calibrated 95 % band 0 .. 16.91 "
-                "spans every plausible SDC (0 to 16.91, the bound of the specimen's particles; "
+                "spans every plausible SDC (0 to 2 pi, a loss factor of 1; "
                 "the calibration does not constrain the SDC here), so it cannot test the "
                 "model: not judged and not counted as inside.") in captions
     else:
@@ -2517,7 +2517,7 @@ def test_a_saved_calibration_is_drawn_with_its_uninformative_band_marked(store_f
     # the list of saved calibrations showed a table and two downloads, no figure: a saved
     # calibration's bands were never drawn there. The chosen one is drawn now by the plotting
     # module (figures_results.calibration_png of Calibration.to_pandas), whose frame carries
-    # the verdicts that mark a band of 0 .. the SDC bound apart
+    # the verdicts that mark a band of 0 .. 2 pi apart
     import pidcore.report.figures_results as figures_results
     from pidcore.app.calibration import SAVED_FIGURE_CAPTION
     from pidcore.calibrate.prediction import VERDICT_COLUMN

@@ -1,5 +1,5 @@
 """A calibration's own outputs judge its bands as the report does: a fold (or in-sample point)
-whose 95 % band spans every plausible SDC (0 .. the SDC bound) is "uninformative", counted
+whose 95 % band spans every plausible SDC (0 .. 2 pi) is "uninformative", counted
 neither inside nor among those judged (summary.md, summary.html, calibration.json's
 ``loo_coverage95``, the store's listing, the command's line). Before, such a band counted as
 "inside": a calibration that constrains nothing at a load case scored a hit there."""
@@ -63,10 +63,14 @@ def test_the_bound_of_the_constructed_folds_is_the_one_their_band_spans():
     bound = calibrated_sdc_bound(paper_specimen(), fill_percent=50.0, material="acrylic")
     assert SDC_UPPER_BOUND < bound.sdc < 25.0
     assert [row_verdict(r, bound) for r in LOO] == ["yes", "no", "uninformative"]
-    # a band from 0 that stops below the bound still judges: 0.5 is inside 0 .. bound - 1
-    below = bound.sdc - 1.0
+    # a band from 0 that stops below 2 pi (a loss factor of 1) still judges: 0.5 is inside
+    # 0 .. 2 pi - 0.5; one from 0 past 2 pi, short of the bound, spans every plausible SDC
+    below = SDC_UPPER_BOUND - 0.5
     assert row_verdict({**LOO[2], "high95": below, "high95_without_stderr": below},
                        bound) == "yes"
+    past = bound.sdc - 1.0
+    assert row_verdict({**LOO[2], "high95": past, "high95_without_stderr": past},
+                       bound) == "uninformative"
     # and one reaching past it from above 0 judges too (0.5 is below 0.6: outside)
     assert row_verdict({**LOO[2], "low95": 0.6, "low95_without_stderr": 0.6, "predicted": 1.0},
                        bound) == "no"
@@ -89,7 +93,7 @@ def test_the_summaries_say_k_of_n_with_the_uninformative_apart():
 
     result = _result()
     text = summary_markdown(result)
-    said = ("inside the 95 % band (1 more uninformative: a band of 0 .. the SDC bound, "
+    said = ("inside the 95 % band (1 more uninformative: a band of 0 .. 2 pi, "
             "spanning every plausible SDC, cannot test the model)")
     loo_rms, rms = rms_text(result.loo_rms), rms_text(result.rms)  # 0.2903, 0.1742
     assert f"## Leave-one-out predictions: RMS {loo_rms}, 1/2 {said}" in text.splitlines()

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from pidcore.calibrate.prediction import Z95, load_calibration
+from pidcore.calibrate.prediction import Z95, judge_measurement, load_calibration
 from pidcore.cli import main
 from pidcore.compare import Tolerances
 from pidcore.errors import ParameterError
@@ -651,6 +651,51 @@ def test_the_calibrate_plot_cuts_a_band_past_two_pi():
     assert not shown_band_bars(rows[1:])[3]
 
 
+def test_a_pooled_pair_whose_band_reaches_past_2_pi_is_uninformative_whichever_bound_cuts_it(
+        tmp_path):
+    # the tester's pooled pair at 500 Hz, 1 g, 50 %: SDC 2.193 and 1.135, mean 1.664 +- 0.529
+    # of 1 degree of freedom (t = 12.71, widening 6.72) beside a prediction of 0.197 whose
+    # band without measurement error is 0.05 .. 0.48: widened to -3 x 0.529 = -1.587 (the
+    # lowest kept SDC) .. 0.197 + hypot(0.283, 6.72) = 6.925. Judged against the paper
+    # coupon's bound at 50 % (16.9) the report said "yes" and counted it inside 1 of 1;
+    # loaded alone (bound 2 pi, the band cut to 6.283) it was "uninformative". A band from
+    # below 0 past 2 pi refutes no plausible SDC: uninformative in both.
+    from pidcore.compare.plausibility import UNKNOWN_SPECIMEN_BOUND, sdc_bound
+    from pidcore.report.table import UNINFORMATIVE
+
+    pooled = {**_prediction(500, 1, 50, 0.197, 0.02, 0.40), "measured_stderr": 0.04,
+              "measured_stderr_dof": 7.0, "low95_without_stderr": 0.05,
+              "high95_without_stderr": 0.48}
+    cal = load_calibration(_write(tmp_path / "calibration.json", [pooled]))
+    hit = cal.lookup(LoadCase(500, 1, 50))
+    assert hit.sdc_bound == sdc_bound(fill_percent=50.0, material="acrylic")
+    assert hit.sdc_bound.sdc > 16.9  # the premise: the report's bound, far above 2 pi
+    low, high = hit.band(0.529, 1.0)
+    # 4 significant digits, as the tester's page wrote the band
+    assert (round(low, 3), round(high, 3)) == (-1.587, 6.925)
+    alone = dataclasses.replace(hit, sdc_bound=UNKNOWN_SPECIMEN_BOUND)
+    assert alone.band(0.529, 1.0) == (low, 2 * math.pi)
+    for prediction in (hit, alone):
+        assert prediction.judge(1.664, 0.529, 1.0)[0] == UNINFORMATIVE
+        assert judge_measurement(prediction, 1.664, 0.529, 1.0).verdict == UNINFORMATIVE
+    # through the report's rows: the pooled row is not counted; a precise one is still judged
+    table = pd.DataFrame({
+        "frequency [Hz]": [500.0, 500.0], "acceleration [g]": [1.0, 1.0],
+        "packing ratio [%]": [50.0, 50.0], "material": ["acrylic"] * 2,
+        "SDC measured (Eq. 11) [-]": [1.664, 0.25],
+        "SDC measured (Eq. 11) stderr [-]": [0.529, 0.04],
+        "SDC measured (Eq. 11) stderr dof [-]": [1.0, 7.0],
+        "note": ["pooled 2 records", ""]})
+    out = add_calibration_columns(table, cal)
+    assert out[CALIBRATED_INSIDE_COLUMN].tolist() == [UNINFORMATIVE, "yes"]
+    assert "inside the 95 % band at 1 of 1 measured row(s) (1 more uninformative" in \
+        out.attrs["notes"][-1]
+    # a band from 0 that stops short of 2 pi still judges: it refutes an SDC above its top
+    short = dataclasses.replace(hit, high95_without_stderr=0.35)
+    assert short.band(0.3, 7.0)[1] < 2 * math.pi
+    assert short.judge(3.0, 0.3, 7.0)[0] == "no"
+
+
 def test_a_band_spanning_every_plausible_sdc_is_uninformative_and_not_counted(tmp_path):
     # the bundled calibration at 500 Hz, 5 g, 50 %: band without measurement error
     # 0.121 .. 0.860 about 0.492. Two records pooled there (stderr 1.795 of 1 degree of
@@ -673,7 +718,7 @@ def test_a_band_spanning_every_plausible_sdc_is_uninformative_and_not_counted(tm
     assert hit.band(1.795, 1.0) == (-3 * 1.795, bound.sdc)
     reason = hit.uninformative_reason(1.795, 1.0)
     assert reason.startswith("uninformative: the calibrated 95 % band -5.385 .. 16.91 spans every "
-                             "plausible SDC (0 to 16.91, the bound of the specimen's particles; "
+                             "plausible SDC (0 to 2 pi, a loss factor of 1; "
                              "this measurement's own scatter widens it)")
     # a band cut at 0 only, or at the bound only, still tests the model
     assert hit.uninformative_reason(0.0, 1.0) == ""
@@ -684,7 +729,7 @@ def test_a_band_spanning_every_plausible_sdc_is_uninformative_and_not_counted(tm
     assert unknown.band(1.795, 1.0) == (-3 * 1.795, 2 * math.pi)
     assert unknown.uninformative_reason(1.795, 1.0).startswith(
         "uninformative: the calibrated 95 % band -5.385 .. 6.283 spans every plausible SDC (0 to "
-        "2 pi; this measurement's own scatter widens it)")
+        "2 pi, a loss factor of 1; this measurement's own scatter widens it)")
     table = pd.DataFrame({
         "frequency [Hz]": [500.0, 50.0, 500.0], "acceleration [g]": [5.0, 5.0, 5.0],
         "packing ratio [%]": [50.0, 50.0, 50.0], "material": ["acrylic"] * 3,
@@ -700,7 +745,7 @@ def test_a_band_spanning_every_plausible_sdc_is_uninformative_and_not_counted(tm
         -3 * 1.795, bound.sdc)
     summary = out.attrs["notes"][-1]
     assert summary.endswith("inside the 95 % band at 2 of 2 measured row(s) (1 more "
-                            "uninformative: a band of 0 .. the SDC bound, spanning every "
+                            "uninformative: a band of 0 .. 2 pi, spanning every "
                             "plausible SDC, "
                             "cannot test the model)")
 
@@ -737,12 +782,12 @@ def test_the_report_files_show_the_uninformative_verdict(tmp_path):
         text = written[fmt].read_text(encoding="utf-8")
         # the row note: the paper coupon's bound at 50 %, 8 m_p/m_s (46.8 g on 22.2 g)
         assert f"{UNINFORMATIVE}: the calibrated 95 % band -5.385 .. 16.91" in text
-        assert "(1 more uninformative: a band of 0 .. the SDC bound" in text  # the report's note
+        assert "(1 more uninformative: a band of 0 .. 2 pi" in text  # the report's note
     labels, rows = pdf_table_cells(table)
     shown = {label.replace("\n", " "): cell for label, cell in zip(labels, rows[0], strict=True)}
     assert shown["measured in calibrated 95 % band"] == UNINFORMATIVE
     assert table.attrs["notes"][-1].endswith("at 0 of 0 measured row(s) (1 more uninformative: a "
-                                             "band of 0 .. the SDC bound, spanning every "
+                                             "band of 0 .. 2 pi, spanning every "
                                              "plausible SDC, "
                                              "cannot test the model)")
 
@@ -835,7 +880,7 @@ def test_the_report_and_the_calibration_summaries_count_uninformative_bands_in_o
                 for case, sdc, stderr, dof in measured]
     assert verdicts == ["uninformative", "yes"]
     words = prediction.uninformative_count_text(1)
-    assert words == (" (1 more uninformative: a band of 0 .. the SDC bound, spanning every "
+    assert words == (" (1 more uninformative: a band of 0 .. 2 pi, spanning every "
                      "plausible SDC, cannot test the model)")
     assert prediction.uninformative_count_text(0) == ""
     note = add_calibration_columns(table, cal).attrs["notes"][-1]
@@ -1006,8 +1051,6 @@ def test_a_negative_measured_sdc_within_its_noise_is_judged_by_a_band_reaching_b
     # the measurement judged "no" by the report, the app and the case sheet. Widened in
     # quadrature it is 0.044 - hypot(0.024, t_7 0.13) = -0.264 .. 0.353: inside
     from scipy import stats
-
-    from pidcore.calibrate.prediction import judge_measurement
 
     row = {**_prediction(100, 1, 50, 0.044, 0.020, 0.080), "measured_stderr": 0.0,
            "low95_without_stderr": 0.020, "high95_without_stderr": 0.080}

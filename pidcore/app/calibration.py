@@ -657,7 +657,7 @@ def calibration_digest(calibration) -> str:
 #: Caption of the figure of a saved calibration on the Calibrate tab (after its key).
 SAVED_FIGURE_CAPTION = ("calibrated SDC per load case with its 95 % band beside the SDC "
                         "measured there; a hollow point with a dashed band is uninformative "
-                        "(0 .. the SDC bound: it cannot test the model)")
+                        "(0 .. 2 pi: it cannot test the model)")
 
 
 def stored_calibration_label(calibration) -> str:

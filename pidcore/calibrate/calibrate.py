@@ -110,7 +110,7 @@ class CalibrationResult:
 
     @property
     def loo_uninformative(self) -> int | None:
-        """How many leave-one-out folds' 95 % bands are uninformative (0 .. the SDC bound):
+        """How many leave-one-out folds' 95 % bands are uninformative (0 .. 2 pi):
         counted neither inside nor among the folds judged (calibration.json's
         ``loo_uninformative95``; a file without it had none counted apart)."""
         if not self.loo:

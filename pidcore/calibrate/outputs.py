@@ -327,9 +327,9 @@ def shown_band_bars(rows: list[dict], bounds: list[float] | None = None
     return pred, below, above, bool(cut.any())
 
 
-#: The legend's words for points whose band spans 0 .. the SDC bound, drawn hollow with a
+#: The legend's words for points whose band spans 0 .. 2 pi, drawn hollow with a
 #: dashed bar (:func:`draw_bands`).
-UNINFORMATIVE_LABEL = "95 % band uninformative (0 .. SDC bound: cannot test the model)"
+UNINFORMATIVE_LABEL = "95 % band uninformative (0 .. 2 pi: cannot test the model)"
 
 
 def draw_bands(ax: Any, x, predicted, low, high, bounds, verdicts, *, label: str,

@@ -130,17 +130,24 @@ def band_text(low: float, high: float) -> str:
     return " .. ".join(sdc_text(v) for v in (low, high))
 
 
+def plausible_sdc_top(bound: SdcBound) -> float:
+    """The top of the SDCs a measurement of a particle damper plausibly has: 2 pi (a loss
+    factor of 1), or the specimen's ``bound`` where that is lower. A calibrated band from 0 (or
+    below) to it refutes none of them (:meth:`CalibratedPrediction.uninformative_reason`)."""
+    return min(SDC_UPPER_BOUND, bound.sdc)
+
+
 def uninformative_count_text(count: int) -> str:
     """How many more bands were ``uninformative`` (:meth:`CalibratedPrediction.judge`),
     counted neither inside nor among those judged, as every count of a calibration's verdicts
     says it after its "k of n inside": the report's note (:func:`pidcore.report.table.
     add_calibration_columns`) and the calibration's summaries and command
     (:func:`pidcore.calibrate.outputs.coverage_text`) wrote these words each in its own copy;
-    ``" (1 more uninformative: a band of 0 .. the SDC bound, spanning every plausible SDC,
+    ``" (1 more uninformative: a band of 0 .. 2 pi, spanning every plausible SDC,
     cannot test the model)"``, "" for none."""
     if count <= 0:
         return ""
-    return (f" ({count} more {BAND_VERDICTS[3]}: a band of 0 .. the SDC bound, spanning "
+    return (f" ({count} more {BAND_VERDICTS[3]}: a band of 0 .. 2 pi, spanning "
             "every plausible SDC, cannot test the model)")
 
 
@@ -293,29 +300,35 @@ class CalibratedPrediction:
 
     def uninformative_reason(self, stderr: float = math.nan, dof: float = math.nan) -> str:
         """Why the 95 % band (:meth:`band`) of a measurement with standard error ``stderr``
-        of ``dof`` degrees of freedom cannot judge it: it spans every plausible SDC, 0 to
-        :attr:`sdc_bound` (the bound a measurement is kept below), so any measurement that can
-        be kept lies inside and "inside" says nothing about the model; "" where the band can
-        judge it.
+        of ``dof`` degrees of freedom cannot judge it: it spans every SDC a measurement of a
+        particle damper plausibly has, from 0 (or below) to :func:`plausible_sdc_top` (2 pi, a
+        loss factor of 1), so it refutes no plausible measurement and "inside" says nothing
+        about the model; "" where the band can judge it.
 
-        A pooled pair of records (stderr 1.8 of 1 degree of freedom, t = 12.7) widened the
-        bundled calibration's 0.12 .. 0.86 to 0 .. 2 pi, and the report counted the row as
-        "inside 1 of 1"."""
+        The top is 2 pi, not :attr:`sdc_bound`: the specimen's bound (16.9 for the paper's
+        coupon at 50 %) is the most its particles could ever dissipate, where a result is
+        refused as a set-up error, not an SDC measurements plausibly have, and the bound a
+        path knows differs (16.9 where the report has the specimen, 2 pi where a prediction is
+        loaded alone). Judged against the bound, a pooled pair of records (SDC 1.664 +- 0.529
+        of 1 degree of freedom, t = 12.7) got the band -1.587 .. 6.925 around 0.197: "inside"
+        in the report (short of 16.9), "uninformative" where loaded alone (cut at 2 pi), for
+        the one band. Against 2 pi the verdict is the same whichever bound cuts the band (each
+        is >= 2 pi). A criterion on the measurement's widening dominating the model's
+        half-width was not taken: such a band (0.05 stderr beside a model's 0.03) still
+        refutes an SDC far off, and the question is whether the band can refute one."""
         low, high = self.band(stderr, dof)
-        bound = self.sdc_bound.sdc
-        # every SDC the coupon can have, 0 .. the bound: a bottom below 0 (a noisy
-        # measurement's, cut at lowest_kept_sdc) holds no more of them
-        if not (low <= 0.0 and high >= bound):
+        top = plausible_sdc_top(self.sdc_bound)
+        # a bottom below 0 (a noisy measurement's, cut at lowest_kept_sdc) refutes no more of
+        # the plausible SDCs than one at 0
+        if not (low <= 0.0 and high >= top):
             return ""
         widening = self._measurement_widening(stderr, dof)
         cause = ("this measurement's own scatter widens it" if widening
                  > self.high95_without_stderr - self.sdc else
                  "the calibration does not constrain the SDC here")
-        upper = ("2 pi" if bound <= SDC_UPPER_BOUND else
-                 f"{bound:.4g}, the bound of the specimen's particles")
         return (f"uninformative: the calibrated 95 % band {band_text(low, high)} spans every "
-                f"plausible SDC (0 to {upper}; {cause}), so it cannot test the model: not "
-                "judged and not counted as inside")
+                f"plausible SDC (0 to 2 pi, a loss factor of 1; {cause}), so it cannot test "
+                "the model: not judged and not counted as inside")
 
     def contains(self, sdc: float, stderr: float = math.nan, dof: float = math.nan) -> bool:
         """True if ``sdc`` lies inside the 95 % band of a measurement with standard error

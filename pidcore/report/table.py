@@ -959,7 +959,7 @@ def add_calibration_columns(table: pd.DataFrame, calibration, *,
                                                 strict=True)):
         out.insert(at + offset, name, values)
     out["note"] = notes
-    # a band of 0 .. the SDC bound holds every measurement: counted neither inside nor among
+    # a band of 0 .. 2 pi refutes no plausible measurement: counted neither inside nor among
     # those judged
     compared = sum(v in (INSIDE, OUTSIDE) for v in inside)
     unjudged = inside.count(UNINFORMATIVE)
