@@ -654,22 +654,32 @@ class SavedAnalyses:
     notes: list[str]
     already_identical: list[str] = field(default_factory=list)
     replaced: list[str] = field(default_factory=list)
+    #: Of the distinct keys held before with the same content, those another analysis of the
+    #: same measurement (other settings) had replaced as the one reports and calibrations use:
+    #: saved again, they are that one again (not in :attr:`already_identical`).
+    made_used_again: list[str] = field(default_factory=list)
 
     @property
     def new(self) -> list[str]:
         """The distinct keys the store did not hold before."""
-        held = {*self.already_identical, *self.replaced}
+        held = {*self.already_identical, *self.replaced, *self.made_used_again}
         return [key for key in dict.fromkeys(self.keys) if key not in held]
 
     def breakdown(self) -> str:
         """How many records were new and how many the store already held (``"0 new, 5
         already held with identical content"``); ``""`` where all were new. "saved 5" of a
-        save done twice did not say the second one changed nothing."""
-        if not self.already_identical and not self.replaced:
+        save done twice did not say the second one changed nothing. A held record another
+        analysis of its file had replaced is counted apart (``"1 already held, made the one
+        reports use again"``): "already held with identical content" beside the note that the
+        save changed which analysis reports use read as "nothing changed"."""
+        if not self.already_identical and not self.replaced and not self.made_used_again:
             return ""
         parts = [f"{len(self.new)} new"]
         if self.already_identical:
             parts.append(f"{len(self.already_identical)} already held with identical content")
+        if self.made_used_again:
+            parts.append(f"{len(self.made_used_again)} already held, made the one reports "
+                         "and calibrations use again")
         if self.replaced:
             # "of other content" beside the note "has the same contents" read as a
             # contradiction: the file is the same, its name, load case, specimen or a field
@@ -752,8 +762,30 @@ def save_analyses(store: Store | str | os.PathLike, results: Sequence[AnalyzedRe
         held = set(before["key"]) & set(keys) if "key" in before.columns else set()
         identical = _identical_entries(before, store.list_analyses(), held) if held else set()
     distinct = list(dict.fromkeys(keys))
-    return SavedAnalyses(keys, notes, [k for k in distinct if k in identical],
-                         [k for k in distinct if k in held - identical])
+    superseded = _superseded(before)
+    return SavedAnalyses(keys, notes,
+                         [k for k in distinct if k in identical and k not in superseded],
+                         [k for k in distinct if k in held - identical],
+                         [k for k in distinct if k in identical and k in superseded])
+
+
+def _newest_first(analyses: pd.DataFrame) -> pd.DataFrame:
+    """A listing of :meth:`~pidcore.store.Store.list_analyses` newest first: of one
+    measurement's analyses the first is the one reports and calibrations use (empty where it
+    lacks the columns that tell)."""
+    if analyses.empty or not {"key", "measurement_key", "created_utc"} <= set(
+            analyses.columns):
+        return analyses.iloc[0:0]
+    # stable: of equal stamps the one listed last was saved last
+    return analyses.iloc[::-1].sort_values("created_utc", kind="stable", ascending=False)
+
+
+def _superseded(analyses: pd.DataFrame) -> set[str]:
+    """Keys of a listing's analyses that another analysis of the same measurement replaced
+    as the one reports and calibrations use (not the newest of their measurement)."""
+    newest = _newest_first(analyses)
+    used = set(newest.drop_duplicates("measurement_key")["key"].astype(str))
+    return set(newest["key"].astype(str)) - used
 
 
 def _identical_entries(before: pd.DataFrame, after: pd.DataFrame, keys: set[str]) -> set[str]:
@@ -869,11 +901,15 @@ def replacement_notes(analyses: pd.DataFrame,
     """
     notes = []
     saved = {}  # measurement key -> (file, load case, parameters, SDC) it holds now
+    # measurement key -> (parameters, SDC) of each analysis of it, newest first
+    kept: dict[str, list[tuple[dict | None, float]]] = {}
     if not analyses.empty and {"measurement_key", "created_utc"} <= set(analyses.columns):
         for _, row in analyses.sort_values("created_utc", kind="stable").iterrows():
             saved[str(row["measurement_key"])] = (
                 Path(str(row.get("source", ""))).name, _stored_case_label(row),
                 _parameters_of(row.get("parameters_json")), _number(row.get("sdc")))
+            kept.setdefault(str(row["measurement_key"]), []).insert(
+                0, (_parameters_of(row.get("parameters_json")), _number(row.get("sdc"))))
     for name, key, case, given, sdc in incoming:
         parameters = _parameters_of(given)
         if key in saved:
@@ -886,6 +922,16 @@ def replacement_notes(analyses: pd.DataFrame,
             elif changed:
                 notes.append(other_settings_note(name, old_parameters, parameters, old_sdc,
                                                  sdc))
+            else:
+                # saved again as it is used: a second Save said only "already held", and the
+                # note of the first (which SDC reports use) was gone from the page
+                earlier = next(((p, s) for p, s in kept.get(key, ())
+                                if _changed_settings(p, parameters)), None)
+                if earlier is not None:
+                    notes.append(other_settings_note(
+                        name, earlier[0], parameters, earlier[1], sdc,
+                        now="still the one reports and calibrations use, the earlier is kept "
+                            "in the store"))
         saved[key] = (name, case, parameters, sdc)
     return notes
 

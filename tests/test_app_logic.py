@@ -1581,6 +1581,39 @@ def test_a_file_saved_again_with_another_delay_says_its_new_sdc_is_the_one_used(
     assert saved_analyses(store_file)["sdc"].tolist() == [again.analysis.sdc]
 
 
+def test_saving_again_keeps_saying_which_analysis_reports_use_and_what_the_save_did(
+        tmp_path, good_csv):
+    # a second click on Save replaced "...saved before with other settings (...); this
+    # analysis is the one reports use now" with only "(0 new, 1 already held with identical
+    # content)"; and saving the earlier settings again made them the ones used, under "0 new,
+    # 1 already held with identical content" beside a note saying the SDC used changed
+    from pidcore.measure import AnalysisOptions
+    from pidcore.store.listing import saved_analyses
+
+    store_file = tmp_path / "s.h5"
+    delayed, plain = AnalysisOptions(velocity_delay_s=2e-5), AnalysisOptions()
+    first = _record(good_csv, delayed, name="a_fill50.csv")
+    again = _record(good_csv, plain, name="a_fill50.csv")
+    uploads.save_records(store_file, [_file(first, delayed)])
+    (replaced,) = uploads.save_records(store_file, [_file(again, plain)]).notes
+    twice = uploads.save_records(store_file, [_file(again, plain)])
+    # the supersede is said again, as still so, and the count says it was held unchanged
+    assert twice.notes == (replaced.replace("is the one reports and calibrations use now",
+                                            "is still the one reports and calibrations use"),)
+    assert f"SDC {first.analysis.sdc:.4g}); this analysis (SDC {again.analysis.sdc:.4g}) is " \
+        "still the one" in twice.notes[0]
+    assert twice.breakdown == "0 new, 1 already held with identical content"
+    assert saved_analyses(store_file)["sdc"].tolist() == [again.analysis.sdc]
+    # the earlier settings saved again: held, and now the one used again, as the count says
+    back = uploads.save_records(store_file, [_file(first, delayed)])
+    assert back.notes[0].endswith(f"this analysis (SDC {first.analysis.sdc:.4g}) is the one "
+                                  "reports and calibrations use now, the earlier is kept in "
+                                  "the store")
+    assert back.breakdown == ("0 new, 1 already held, made the one reports and calibrations "
+                              "use again")
+    assert saved_analyses(store_file)["sdc"].tolist() == [first.analysis.sdc]
+
+
 def test_the_page_says_a_changed_setting_in_its_field_and_unit():
     # the Analyse page's warning after a save said "velocity_delay_s 5e-05 -> 0.0" beside a
     # settings column in µs; null is a setting not given (a structure mass left at 0)
@@ -1770,6 +1803,32 @@ def test_run_says_which_cases_are_already_stored():
         "1 job(s) submitted; 1 already in the store, not run again; 1 already queued or "
         "running, not submitted again")
     assert jobs.submitted_text(1, [queued]) == "1 job(s) submitted"
+
+
+def test_run_clicked_twice_names_the_job_already_queued_or_running(tmp_path):
+    # a double click on Run said "0 job(s) submitted; 1 already queued or running": no job
+    # named, and "0 submitted" read as a failure
+    from pidcore.dem import DemConfig
+
+    runner = jobs.DemJobRunner(tmp_path / "dem.h5")
+    cases = jobs.plan_dem_cases([50.0], [5.0], [50.0], material="acrylic", direction="z")
+    config = DemConfig(cells=1, steady_cycles=5000)  # long: still queued or running below
+    try:
+        (first,) = runner.submit(cases, config)
+        again = runner.submit(cases, config)
+        assert list(again) == [] and again.already == [first]
+        assert jobs.submitted_text(1, again) == (
+            f"{first.job_id} (50 Hz, 5 g, 50 %) already queued or running: not submitted twice")
+        # beside a case that is submitted, the one not submitted is named too
+        more = runner.submit([*cases, *jobs.plan_dem_cases(
+            [60.0], [5.0], [50.0], material="acrylic", direction="z")], config)
+        assert [j.case.frequency_hz for j in more] == [60.0] and more.already == [first]
+        assert jobs.submitted_text(2, more) == (
+            f"1 job(s) submitted; {first.job_id} (50 Hz, 5 g, 50 %) already queued or "
+            "running, not submitted twice")
+    finally:
+        runner.cancel()
+        runner.wait_cancelled(5.0)
 
 
 def test_available_calibrations_list_this_stores_first_and_say_what_cannot_be_read(tmp_path):

@@ -192,9 +192,14 @@ def test_a_file_saved_again_with_other_settings_says_which_result_reports_use_no
             "the one reports and calibrations use now") in out
     newest = latest_per_measurement(Store(store_path).list_analyses())
     assert f"{float(newest['sdc'].iloc[0]):.4g}" == second  # what the note says is used
-    # the same settings again: nothing replaced, nothing said
+    # the same settings again: nothing replaced, and the save still says which is used (a
+    # second save said nothing of it, as if the earlier analysis were gone)
     assert main(argv) == 0
-    assert "saved before with other settings" not in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "use now" not in out
+    assert (f"this analysis (SDC {second}) is still the one reports and calibrations use, the "
+            "earlier is kept in the store") in out
+    assert "(0 new, 1 already held with identical content)" in out
 
 
 @pytest.mark.parametrize("scale", [1e-3, 1e3])

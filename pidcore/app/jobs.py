@@ -310,6 +310,17 @@ class JournalOwner:
         return not zombie and abs(started - self.started) <= _START_TOLERANCE_S
 
 
+class SubmittedJobs(list):
+    """The jobs :meth:`DemJobRunner.submit` created (a list of :class:`DemJob`), and
+    :attr:`already`: the jobs queued or running that cases of the submission are, so not
+    submitted twice (a double click on Run said only "1 already queued or running", naming
+    no job)."""
+
+    def __init__(self, created: Sequence[DemJob] = (), already: Sequence[DemJob] = ()):
+        super().__init__(created)
+        self.already: list[DemJob] = list(already)
+
+
 class DemJobRunner:
     """Queue of DEM cases for one store, run one at a time by a background thread.
 
@@ -346,16 +357,17 @@ class DemJobRunner:
 
     # --- used by the page ---------------------------------------------------------------------
 
-    def submit(self, cases: Sequence, config, specimen=None) -> list[DemJob]:
+    def submit(self, cases: Sequence, config, specimen=None) -> SubmittedJobs:
         """Queue ``cases`` with ``config`` on ``specimen`` (:class:`pidcore.specimen.Specimen`;
         None: the paper's coupon); returns the jobs created (duplicates are skipped: a run
-        queued or running is not submitted again; a run already in the store, or the same
-        simulation as a job queued or running, this submission's included, gets a job that
-        says so and is not run: :data:`SAME_RUN_STATE`)."""
+        queued or running is not submitted again, and :attr:`SubmittedJobs.already` names its
+        job; a run already in the store, or the same simulation as a job queued or running,
+        this submission's included, gets a job that says so and is not run:
+        :data:`SAME_RUN_STATE`)."""
         from ..dem.persist import own_run_keys, run_identity, run_key
 
         lookup = self._stored_runs()  # the stores' runs, read once per submission
-        created = []
+        created, already = SubmittedJobs(), []
         # the journal locked from reading it to writing it: job numbers are unique across
         # every app server of the store, and another server's queued runs are seen
         with self._lock, self._journal_locked():
@@ -382,7 +394,8 @@ class DemJobRunner:
                     continue
                 running = active.get(identity)
                 if running is not None and running.run_key == key:
-                    continue  # this very run is queued or running
+                    already.append(running)  # this very run is queued or running
+                    continue
                 self._counter += 1
                 job = DemJob(f"job{self._counter:04d}", case, config, key, specimen)
                 found, where = lookup(case, config, specimen)
@@ -410,6 +423,8 @@ class DemJobRunner:
             if created:
                 self._write_journal()
             self._wake.notify_all()
+        # a case given twice names its job once
+        created.already = list({j.job_id: j for j in already}.values())
         return created
 
     def _stored_runs(self):
@@ -1142,7 +1157,8 @@ def submitted_text(n_cases: int, created: Sequence[DemJob]) -> str:
     """What a click on Run did: jobs that will run, runs already in the store (not run
     again), cases that are the same simulation as another job (run once), cases the DEM
     cannot run (a fill rounding to no particle: not run, the first one's reason said), and
-    cases already queued or running (not submitted again)."""
+    cases already queued or running (not submitted twice: by their jobs where ``created``
+    is :meth:`DemJobRunner.submit`'s :class:`SubmittedJobs`, else counted)."""
     stored = sum(j.state == "in store" for j in created)
     same = sum(j.state == SAME_RUN_STATE for j in created)
     refused = [j for j in created if j.state == "failed"]  # cases the DEM cannot run
@@ -1155,9 +1171,20 @@ def submitted_text(n_cases: int, created: Sequence[DemJob]) -> str:
         parts.append(f"{same} the same simulation as another job (same particle count and "
                      "seed), run once")
     skipped = n_cases - len(created)
-    if skipped:
+    already = getattr(created, "already", ())
+    if already and not created:  # nothing else to say: "0 job(s) submitted" read as a failure
+        return f"{_jobs_words(already)} already queued or running: not submitted twice"
+    if already:
+        parts.append(f"{_jobs_words(already)} already queued or running, not submitted twice")
+    elif skipped:
         parts.append(f"{skipped} already queued or running, not submitted again")
     return "; ".join(parts)
+
+
+def _jobs_words(listed: Sequence[DemJob]) -> str:
+    """Jobs by id and load case, ``"job0003 (500 Hz, 1 g, 50 %)"``, ", "-joined."""
+    return ", ".join(f"{j.job_id} ({j.case.label()})" if hasattr(j.case, "label")
+                     else j.job_id for j in listed)
 
 
 def steady_state_text(detected) -> str:
