@@ -4,8 +4,11 @@ F = F0 sin(wt), V = V0 sin(wt - phi) (loss factor tan(90 deg - phi))."""
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 import pytest
-from test_io_din_headers import ETA, write_export
+from test_io_din_headers import ETA, F0, FREQ, FS, PHI, V0, write_export
 
 from pidcore.cli import main
 from pidcore.errors import ChannelError
@@ -62,3 +65,32 @@ def test_naming_the_channel_for_its_role_with_a_unit_reads_it_so(tmp_path):
     record = analyze_file(path, AnalysisOptions(velocity="Velocity", velocity_unit="m/s"))
     assert record.analysis.loss_factor == pytest.approx(ETA, rel=1e-6)
     assert not [n for n in record.notes if "named like" in n]
+
+
+def test_an_unused_velocity_named_column_in_g_beside_the_acceleration_is_said(tmp_path, capsys):
+    # 'Velocity [g]' (a velocity in m/s exported under the unit g) beside 'Acceleration
+    # [m/s^2]': two accelerations by their units, the one named so taken as the motion, and
+    # the velocity-named one left out with only "ignored channels (not needed): 'Velocity'";
+    # the note of a name against its unit was said only of a channel used
+    t = np.arange(int(FS)) / FS
+    w = 2 * math.pi * FREQ
+    rows = zip(t, F0 * np.sin(w * t), V0 * np.sin(w * t - PHI),
+               w * V0 * np.cos(w * t - PHI), strict=True)
+    path = tmp_path / "velocity_in_g.csv"
+    path.write_text("Time [s],Force [N],Velocity [g],Acceleration [m/s^2]\n" + "".join(
+        ",".join(f"{x:.12g}" for x in row) + "\n" for row in rows), encoding="utf-8")
+    record = analyze_file(path)
+    assert record.channels_used.get("velocity", "") == ""
+    assert record.channels_used["acceleration"] == "Acceleration"
+    # the acceleration is the velocity's exact derivative: its loss factor is the truth (12
+    # printed digits over whole periods; 1e-6 catches any unit or phase slip)
+    assert record.analysis.loss_factor == pytest.approx(ETA, rel=1e-6)
+    (note,) = [n for n in record.notes if "named like" in n]
+    assert ("channel 'Velocity' is named like a velocity but its unit 'g' is an acceleration "
+            "unit: not used (its unit makes it an acceleration, its name a velocity: check "
+            "which quantity it holds); if it is the velocity, name it with "
+            "velocity='Velocity' and give its unit with velocity_unit=UNIT") in note
+    assert main(["analyze", str(path), "--no-store", "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert "'Velocity' is named like a velocity but its unit 'g' is an acceleration unit: " \
+        "not used" in out and "--velocity 'Velocity'" in out

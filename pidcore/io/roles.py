@@ -25,7 +25,9 @@ uses are listed in :attr:`RoleAssignment.ignored`.
 
 A channel detected by its unit whose name says another role (``Velocity [N]``) is used as its
 unit says, and :attr:`RoleAssignment.notes` says so: the unit scales the numbers, the name is
-free text. Where the unit leaves a role its name says empty, the refusal names the column.
+free text. Such a channel that no role uses (a ``Velocity [g]`` beside an acceleration channel)
+is noted too: the quantity its name says was never read. Where the unit leaves a role its name
+says empty, the refusal names the column.
 """
 
 from __future__ import annotations
@@ -83,7 +85,8 @@ class RoleAssignment:
         Names of the channels no role uses.
     notes : tuple of str
         What the output must say: a channel taken for a role by its unit while its name says
-        another role (``"Velocity [N]"`` used as the force).
+        another role (``"Velocity [N]"`` used as the force), or left unused so (``"Velocity
+        [g]"`` beside the acceleration used).
     """
 
     force: Channel
@@ -118,11 +121,20 @@ def _unit_over_name_note(source: str, channel: Channel, role: str) -> str | None
     named = _role_of_the_name(channel, role)
     if named is None or channel.quantity != role:
         return None
-    return (f"{source}: channel {channel.name!r} is named like {a_or_an(named)} but its unit "
-            f"{channel.source_unit or channel.unit!r} is {a_or_an(role)} unit: used as the "
-            f"{role}, as its unit says (the unit scales its numbers; a name is free text); if "
-            f"it is the {named}, name it with {_OPTIONS[named]}{channel.name!r} and give its "
-            f"unit with {named}_unit=UNIT")
+    said, remedy = _name_against_unit(channel, named)
+    return (f"{source}: channel {said}: used as the {role}, as its unit says (the unit scales "
+            f"its numbers; a name is free text); {remedy}")
+
+
+def _name_against_unit(channel: Channel, named: str) -> tuple[str, str]:
+    """(``"'Velocity' is named like a velocity but its unit 'N' is a force unit"``, ``"if it
+    is the velocity, name it with velocity='Velocity' and give its unit with
+    velocity_unit=UNIT"``): the words every note and refusal of a channel whose name says the
+    role ``named`` and whose unit another quantity gives it."""
+    return (f"{channel.name!r} is named like {a_or_an(named)} but its unit "
+            f"{channel.source_unit or channel.unit!r} is {a_or_an(channel.quantity)} unit",
+            f"if it is the {named}, name it with {_OPTIONS[named]}{channel.name!r} and give "
+            f"its unit with {named}_unit=UNIT")
 
 
 def _misnamed_hint(measurement: Measurement, roles: tuple[str, ...],
@@ -135,11 +147,23 @@ def _misnamed_hint(measurement: Measurement, roles: tuple[str, ...],
             continue
         named = [r for r in roles if _role_of_the_name(channel, channel.quantity) == r]
         if named:
-            return (f" ({channel.name!r} is named like {a_or_an(named[0])} but its unit "
-                    f"{channel.source_unit or channel.unit!r} is {a_or_an(channel.quantity)} "
-                    f"unit: if it is the {named[0]}, name it with {_OPTIONS[named[0]]}"
-                    f"{channel.name!r} and give its unit with {named[0]}_unit=UNIT)")
+            said, remedy = _name_against_unit(channel, named[0])
+            return f" ({said}: {remedy})"
     return ""
+
+
+def _unused_against_name_note(source: str, channel: Channel) -> str | None:
+    """The note that a channel no role uses has a name saying another role than its unit: a
+    'Velocity [g]' beside an 'Acceleration [m/s^2]' was left out as "not needed" without a
+    word that the velocity its name promises was never read (its unit said acceleration)."""
+    if channel.quantity not in _OPTIONS:
+        return None
+    named = _role_of_the_name(channel, channel.quantity)
+    if named is None:
+        return None
+    said, remedy = _name_against_unit(channel, named)
+    return (f"{source}: channel {said}: not used (its unit makes it {a_or_an(channel.quantity)}, "
+            f"its name {a_or_an(named)}: check which quantity it holds); {remedy}")
 
 
 def _names(channels: list[Channel]) -> str:
@@ -294,11 +318,12 @@ def assign_roles(measurement: Measurement, *, force: str | None = None,
                            f"{_misnamed_hint(measurement, ('velocity', 'acceleration'), taken)}"
                            "; name one with velocity=NAME or acceleration=NAME")
     used = {c.name for c in chosen.values() if c is not None}
-    notes = [_unit_over_name_note(measurement.source, channel, role)
-             for role, channel in chosen.items()
-             if channel is not None and explicit[role] is None]
+    ignored = [c for c in measurement.channels if c.name not in used]
+    notes = [*(_unit_over_name_note(measurement.source, channel, role)
+               for role, channel in chosen.items()
+               if channel is not None and explicit[role] is None),
+             *(_unused_against_name_note(measurement.source, c) for c in ignored)]
     return RoleAssignment(force=chosen["force"], velocity=chosen["velocity"],
                           acceleration=chosen["acceleration"],
-                          ignored=tuple(c.name for c in measurement.channels
-                                        if c.name not in used),
+                          ignored=tuple(c.name for c in ignored),
                           notes=tuple(note for note in notes if note))
