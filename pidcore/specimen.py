@@ -345,6 +345,26 @@ PLAUSIBLE_RANGES["wall_density_kg_m3"] = PLAUSIBLE_RANGES["density_kg_m3"]
 PLAUSIBLE_RANGES["wall_youngs_modulus_pa"] = PLAUSIBLE_RANGES["youngs_modulus_pa"]
 
 
+#: Largest normal restitution a pair may state (1: an elastic impact; more gains energy).
+MAX_RESTITUTION = 1.0
+#: Pair fields checked against one :data:`PLAUSIBLE_RANGES` entry of another name.
+_PAIR_RANGE_KEYS = {"sliding_friction": "friction", "static_friction": "friction"}
+
+
+def field_domain(path: str) -> tuple[float, float]:
+    """Closed range a numeric field (dotted path, e.g. ``pairs.particle_wall.restitution``)
+    must lie within by a rule of its own: 0 < restitution <= :data:`MAX_RESTITUTION`, or its
+    :data:`PLAUSIBLE_RANGES` entry (frictions 0..2, ...); (-inf, inf) where the file checks it
+    only against other fields or by an open bound (a particle that fits its cell, Poisson's
+    ratio < 0.5)."""
+    leaf = path.rpartition(".")[2]
+    if leaf == "restitution":
+        return math.nextafter(0.0, 1.0), MAX_RESTITUTION
+    key = _PAIR_RANGE_KEYS.get(leaf, leaf) if path.startswith("pairs.") else leaf
+    r = PLAUSIBLE_RANGES.get(key)
+    return (r.low, r.high) if r is not None else (-math.inf, math.inf)
+
+
 def _plausible(where: str, key: str, value: float) -> None:
     """Refuse a (finite, signed-checked) value outside :data:`PLAUSIBLE_RANGES` of ``key``."""
     r = PLAUSIBLE_RANGES[key]
@@ -568,7 +588,7 @@ class PairSpec:
 
     def check(self, where: str) -> None:
         """Raise a ParameterError naming ``where`` if a value is out of range."""
-        if not (math.isfinite(self.restitution) and 0 < self.restitution <= 1):
+        if not (math.isfinite(self.restitution) and 0 < self.restitution <= MAX_RESTITUTION):
             raise _fail(f"{where} restitution",
                         f"expected 0 < e <= 1, got {self.restitution!r}")
         _non_negative(f"{where} sliding_friction", self.sliding_friction, "[-]")

@@ -694,3 +694,48 @@ def test_the_coupon_mass_moves_no_particle_and_the_fit_observes_the_start_specim
 
     with pytest.raises(ParameterError, match=r"^fit: coupon\.mass_kg cannot be fitted"):
         api.parse_fit(["fixture_mass_kg", "coupon.mass_kg"], start)
+
+
+@pytest.mark.parametrize("fit, first, second, field", [
+    # restitution_pp overrode restitution's particle-particle value: 54 DEM runs, and a
+    # calibrated file whose header said 0.86 for both pairs above a body holding 0.54
+    ("restitution,restitution_pp,fixture_mass_kg", "restitution", "restitution_pp",
+     "pairs.particle_particle.restitution"),
+    # docs/calibration.md calls them the same parameter; the one named last won
+    ("static_friction_pw,pairs.particle_wall.static_friction", "static_friction_pw",
+     "pairs.particle_wall.static_friction", "pairs.particle_wall.static_friction"),
+    ("pairs.particle_wall.restitution,restitution", "pairs.particle_wall.restitution",
+     "restitution", "pairs.particle_wall.restitution"),
+    ("fixture_mass_kg,coupon.fixture_mass_kg", "fixture_mass_kg", "coupon.fixture_mass_kg",
+     "coupon.fixture_mass_kg"),
+])
+def test_two_fit_names_that_set_one_field_are_refused_naming_both_and_the_field(
+        capsys, tmp_path, fit, first, second, field):
+    _refused(capsys, tmp_path, ["--data", str(_table(tmp_path)), "--fit", fit],
+             f"fit: {first} and {second} both set {field}; fit one of them")
+
+
+@pytest.mark.parametrize("fit", ["restitution_pp,restitution_pw", "friction,static_friction",
+                                 "friction,pairs.particle_wall.static_friction"])
+def test_names_that_set_other_fields_are_fitted_together(fit):
+    # each pair's own value, and a stick limit above a Coulomb friction (specimen_with's rule:
+    # static friction replaces the one friction moved along) are parameters of their own
+    import pidcore.calibrate as api
+
+    assert api.parse_fit(fit) == fit.split(",")
+
+
+@pytest.mark.parametrize("pair, stated", [("particle_particle", 0.9), ("particle_wall", 0.8)])
+def test_a_restitutions_default_prior_is_cut_at_one_and_said(pair, stated):
+    # 1.5 x 0.9 = 1.35 > 1: --fit pairs.particle_particle.restitution alone was always refused
+    # as outside the physical domain, whatever the specimen stated
+    name = f"pairs.{pair}.restitution"
+    start = paper_specimen().with_values({name: stated})
+    spec, _ = build_specs([name], specimen=start)
+    assert (spec.low, spec.high) == (0.5 * stated, 1.0)  # exact: min(1.5 x, 1) and 0.5 x
+    assert "high cut to 1, the field's limit" in spec.description
+    # a field whose 1.5 x stays inside keeps the documented 0.5 .. 1.5 x, said as nothing
+    density, _ = build_specs(["particles.density_kg_m3"], specimen=start)
+    value = start.particles.density_kg_m3
+    assert (density.low, density.high) == (0.5 * value, 1.5 * value)
+    assert "cut" not in density.description

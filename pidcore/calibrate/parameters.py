@@ -136,6 +136,46 @@ def friction_paths(name: str) -> tuple[str, tuple[str, ...]] | None:
     return None
 
 
+def fields_set(name: str) -> tuple[str, ...]:
+    """Specimen fields (dotted paths) that fitting ``name`` sets: an alias's field of each
+    pair it names (``restitution``: both pairs' ``restitution``), an observation parameter's
+    coupon field, a dotted path itself. ``friction`` is counted as the sliding friction it
+    stands for: the static friction it moves along is the one a ``static_friction`` fitted
+    beside it replaces as the stick limit, by design (:func:`pidcore.calibrate.runner.
+    specimen_with`), not an overlap."""
+    name = OBSERVATION_PATHS.get(name, name)
+    if name in CATALOGUE:
+        return tuple(path for path, n in OBSERVATION_PATHS.items() if n == name)
+    alias = dem_alias_paths(name)
+    if alias is not None:
+        field, pairs = alias
+        return tuple(f"pairs.{pair}.{field}" for pair in pairs)
+    return (name,)
+
+
+def _check_no_overlap(given: Sequence[str]) -> None:
+    """Refuse two fitted names that set one specimen field (:func:`fields_set`).
+
+    ``restitution,restitution_pp`` was fitted as two parameters: each design point ran the
+    specimen with the one named last (:func:`pidcore.calibrate.runner.specimen_with`), so the
+    other's posterior was its prior, a whole design was spent on it, and the calibrated file's
+    header stated a value its body did not hold.
+    """
+    owner: dict[str, str] = {}
+    for name in given:
+        for path in fields_set(name):
+            if path not in owner:
+                owner[path] = name
+                continue
+            first = owner[path]
+            if first == name:
+                raise ParameterError(f"fit: {name} is named twice; name it once")
+            both = next((n for n in (first, name) if len(fields_set(n)) > 1), "")
+            raise ParameterError(f"fit: {first} and {name} both set {path}; fit one of them"
+                                 + (f" ({both} sets both pairs: fit {both}_pp and {both}_pw "
+                                    "for each pair apart)" if both else ""))
+
+
 def dem_parameter_names() -> list[str]:
     """Named DEM parameters ``--fit`` accepts besides dotted specimen paths."""
     return [f"{n}{s}" for n in _DEM_ALIASES for s in ("", "_pp", "_pw")]
@@ -184,7 +224,7 @@ def _specimen(specimen):
 def parameter_spec(name: str, specimen=None) -> ParameterSpec:
     """Default spec of a fittable name: an observation parameter, a named DEM parameter, or
     any numeric specimen field by dotted path (default bounds 0.5x..1.5x its value)."""
-    from ..specimen import numeric_fields
+    from ..specimen import field_domain, numeric_fields
 
     name = OBSERVATION_PATHS.get(name, name)
     specimen = _specimen(specimen)
@@ -207,8 +247,18 @@ def parameter_spec(name: str, specimen=None) -> ParameterSpec:
         value = float(_field_value(specimen, name))
         unit = field_unit(name)
         if value > 0:
-            return ParameterSpec(name, "dem", value, 0.5 * value, 1.5 * value,
-                                 f"specimen field {name}", unit=unit)
+            # 1.5 x a restitution of 0.9 is 1.35: the default prior of a field was refused
+            # as outside the domain whatever its value, so it is cut to the field's own rule
+            low, high = field_domain(name)
+            cut = [f"{which} cut to {as_given(bound)}, the field's limit"
+                   for which, bound, wanted in (("low", low, 0.5 * value),
+                                                ("high", high, 1.5 * value))
+                   if (wanted < bound if which == "low" else wanted > bound)]
+            return ParameterSpec(name, "dem", value, max(0.5 * value, low),
+                                 min(1.5 * value, high),
+                                 f"specimen field {name}"
+                                 + (f" (default prior 0.5 .. 1.5 x its value, "
+                                    f"{'; '.join(cut)})" if cut else ""), unit=unit)
         return ParameterSpec(name, "dem", value, float("nan"), float("nan"),
                              f"specimen field {name} (give priors={name}=LOW:HIGH)",
                              unit=unit)
@@ -239,11 +289,14 @@ def _field_value(specimen, path: str):
 
 def parse_fit(text: str | Sequence[str] | None, specimen: Specimen | None = None
               ) -> list[str]:
-    """Names from ``--fit a,b``; unknown names are a one-line error."""
+    """Names from ``--fit a,b``; an unknown name, and two names that set one specimen field
+    (an alias and a pair's own alias or dotted path, :func:`fields_set`), are a one-line
+    error, before any DEM run."""
     if text is None:
         return list(DEFAULT_FIT)
-    names = [n.strip() for n in (text.split(",") if isinstance(text, str) else text)]
-    names = [OBSERVATION_PATHS.get(n, n) for n in names if n]
+    given = [n.strip() for n in (text.split(",") if isinstance(text, str) else text)]
+    given = [n for n in given if n]
+    names = [OBSERVATION_PATHS.get(n, n) for n in given]
     if not names:
         raise ParameterError("fit: no parameter named")
     for name in names:
@@ -261,8 +314,7 @@ def parse_fit(text: str | Sequence[str] | None, specimen: Specimen | None = None
                 f"state the coupon's mass in the specimen file")
         parameter_spec(name, specimen)
         _refuse_whole_number(name, specimen)
-    if len(set(names)) != len(names):
-        raise ParameterError(f"fit: a parameter is named twice in {','.join(names)}")
+    _check_no_overlap(given)
     return names
 
 
