@@ -739,3 +739,74 @@ def test_a_restitutions_default_prior_is_cut_at_one_and_said(pair, stated):
     value = start.particles.density_kg_m3
     assert (density.low, density.high) == (0.5 * value, 1.5 * value)
     assert "cut" not in density.description
+
+
+def test_sdcs_in_percent_below_the_bound_are_refused_after_the_fit_asking_so(capsys, tmp_path):
+    # a tester's own specimen, 1 mm steel spheres at 6-10 % on a 40 g structure: its SDC bound
+    # is 2 pi, so SDCs typed in percent (1.7 .. 4.3) passed the plausibility check and were
+    # fitted to exit 0 with notes; the DEM reaches ~0.2-0.7 here (> 2 x below each of them)
+    specimen = tmp_path / "steel1mm.toml"
+    specimen.write_text(STEEL_1MM)
+    table = _table(tmp_path, "frequency_hz,acceleration_g,fill_percent,sdc,sdc_stderr,"
+                   "sdc_stderr_dof,material\n200,1,6,4.0,0.3,7,steel\n400,3,10,3.7,0.19,7,steel\n"
+                   "800,5,10,4.3,0.2,7,steel\n800,12,6,1.7,0.08,7,steel\n")
+    out = tmp_path / "out"
+    code = main(["calibrate", "--data", str(table), "--specimen", str(specimen),
+                 "--dem-store", str(tmp_path / "dem.h5"), "--out", str(out), *TINY])
+    err = capsys.readouterr().err.strip()
+    assert code == 2, err
+    last = err.splitlines()[-1]
+    assert "m.csv: every measured SDC (1.7 .. 4.3) is above 1" in last, err
+    assert "was the SDC given in percent?" in last
+    assert not out.exists()
+
+
+STEEL_1MM = """schema_version = 1
+name = "steel1mm_own"
+
+[cell]
+shape = "hexagonal"
+inscribed_diameter_m = 6.35e-3
+height_m = 6.0e-3
+count = 286
+wall_material = "aluminium_wall"
+
+[coupon]
+mass_kg = 0.030
+fixture_mass_kg = 0.010
+baseline_loss_factor = 0.0
+
+[particles]
+material = "steel"
+radius_m = 0.5e-3
+density_kg_m3 = 7850.0
+youngs_modulus_pa = 200e9
+poisson_ratio = 0.29
+count_per_cell = 12
+
+[pairs.particle_particle]
+restitution = 0.9
+sliding_friction = 0.3
+static_friction = 0.4
+rolling_friction = 0.01
+
+[pairs.particle_wall]
+restitution = 0.8
+sliding_friction = 0.35
+static_friction = 0.45
+rolling_friction = 0.01
+"""
+
+
+def test_a_fit_that_reaches_sdcs_above_one_is_not_taken_for_percent():
+    # the bundled exports' SDCs are 1.1 .. 4.1: real, and fitted where the model reaches them;
+    # a point within 2 x of its prediction is one the fit reaches
+    from pidcore.calibrate.calibrate import check_not_percent
+
+    points = [MeasuredPoint(frequency_hz=f, acceleration_g=5.0, fill_percent=50.0, sdc=sdc,
+                            source="t.csv") for f, sdc in ((100.0, 1.1), (500.0, 4.1))]
+    check_not_percent(points, [0.6, 3.0])  # 1.1 / 0.6 = 1.8 < 2: reached
+    with pytest.raises(ParameterError, match=r"^t\.csv: .* at least 2\.05 x .* in percent\?"):
+        check_not_percent(points, [0.5, 2.0])
+    # the same values as fractions of percent are left alone whatever the fit gives
+    check_not_percent([dataclasses.replace(p, sdc=p.sdc / 100) for p in points], [1e-4, 1e-4])

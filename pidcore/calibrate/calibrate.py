@@ -640,6 +640,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     notes += unconstrained_notes(specs, samples)
     rng = np.random.default_rng(posterior_seed + 1)
     predictions = [_row(points[i], predictive(model, samples, i, rng=rng)) for i in everything]
+    check_not_percent(points, [r["predicted"] for r in predictions])
     energy = energy_check(model, samples, specimen)
     loo = None
     if cross_validate == "loo":
@@ -696,6 +697,39 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
 
 #: What a stop says (:func:`pidcore.interrupt.raise_if_stopped`).
 _STOPPED = "calibration stopped; the DEM runs saved before are kept"
+
+
+#: Least ratio of every measured SDC to its calibrated prediction at which a table of SDCs all
+#: above 1 is taken for percentages (:func:`check_not_percent`): a fit that reaches its data
+#: leaves them on both sides of its prediction, the paper's worst point is 1.6 x its
+#: prediction, and a percentage is 100 x the SDC.
+PERCENT_SHORTFALL = 2.0
+
+
+def check_not_percent(points: Sequence[MeasuredPoint], predicted: Sequence[float]) -> None:
+    """Refuse measured SDCs that are all above 1 and all at least :data:`PERCENT_SHORTFALL`
+    times the calibrated prediction (posterior median) of their load case: the fit cannot
+    reach any of them, as with SDCs typed in percent (4.3 for 0.043).
+
+    The plausibility check refuses a value above its specimen's SDC bound
+    (:func:`pidcore.compare.plausibility.sdc_bound`, ``max(2 pi, 8 m_p/m_s)``) as it is read;
+    percentages of a light bed (1.7 .. 4.3 for 1 mm steel spheres at 6-10 %) lie below 2 pi
+    and were fitted, exit 0, with only "piles against its bound" notes: the discrepancy at
+    the top of its prior and bands wide enough to hold 3 of 6. Real SDCs above 1 that the
+    model reaches (the bundled exports' 1.1 .. 4.1) are left alone.
+    """
+    if not points or not all(p.sdc > 1 for p in points):
+        return
+    ratios = [p.sdc / s if s > 0 else math.inf for p, s in zip(points, predicted, strict=True)]
+    if min(ratios) < PERCENT_SHORTFALL:
+        return
+    sources = ", ".join(dict.fromkeys(p.source for p in points if p.source)) or "the data"
+    raise ParameterError(
+        f"{sources}: every measured SDC ({min(p.sdc for p in points):.4g} .. "
+        f"{max(p.sdc for p in points):.4g}) is above 1 and at least {min(ratios):.3g} x the "
+        f"calibrated prediction of its load case ({min(predicted):.4g} .. "
+        f"{max(predicted):.4g}): the fit cannot reach them; was the SDC given in percent? "
+        "expected the SDC as a fraction (4.3 % is 0.043); the DEM runs are kept for a re-run")
 
 
 def _released_share(record: dict) -> float | None:
