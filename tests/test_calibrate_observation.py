@@ -242,3 +242,31 @@ def test_a_bound_note_gives_the_median_as_the_summary_shows_it():
     assert "a value inside the 95 % interval still fits them" in note
     # the premise: the Monte-Carlo error leaves fewer digits than the 4 the note printed
     assert median != f"{float(np.median(piled)):.4g}"
+
+
+def test_the_calibrated_file_states_what_its_own_values_predict_by_eq_11(tmp_path):
+    # the file holds each parameter's marginal median, and the "calibrated DEM" column is the
+    # posterior median of the SDC: with correlated parameters they differ (16 % in a tester's
+    # fit) and the file's header said nothing of what a DEM re-run of it gives. Fitting only
+    # observation parameters leaves one DEM run per case, so the truth is Eq. 11 of that run's
+    # masses at the file's fixture mass and baseline loss factor
+    from pidcore.calibrate import MeasuredPoint, calibrate
+    from pidcore.calibrate.outputs import specimen_text
+    from pidcore.calibrate.prediction import sdc_text
+
+    points = [MeasuredPoint(frequency_hz=f, acceleration_g=a, fill_percent=50.0, sdc=sdc)
+              for f, a, sdc in ((500.0, 5.0, 0.6), (1000.0, 5.0, 0.6), (500.0, 1.0, 0.2))]
+    result = calibrate(points, fit="fixture_mass_kg,baseline_loss_factor",
+                       store_path=tmp_path / "dem.h5", cells=2, steady_cycles=10, workers=1,
+                       progress=False)
+    written = result.calibrated_specimen().coupon
+    truth = [float(obs[0].sdc(written.fixture_mass_kg, written.baseline_loss_factor))
+             for obs in result.observations]
+    # the surrogate of one design run is that run's masses up to its fitted GP mean's
+    # rounding (a nugget over a single point): 1e-3 relative, below the 4 digits shown
+    np.testing.assert_allclose(result.file_predicted, truth, rtol=1e-3)
+    header = specimen_text(result).split("schema_version")[0]
+    assert "this file's own values (each parameter's posterior median) predict" in header
+    for row, own in zip(result.predictions, result.file_predicted, strict=True):
+        assert f"{sdc_text(own)} (posterior median {sdc_text(row['predicted'])}" in header
+    assert result.full_document()["calibrated_file_predicted"] == result.file_predicted

@@ -963,3 +963,32 @@ def test_elastic_contacts_that_cannot_settle_a_dense_start_say_why_and_what_work
     err = capsys.readouterr().err
     assert "no contact is damped (restitution 1 for both pairs)" in err
     assert "start with --packing loose" in err and len(err.strip().splitlines()) == 1
+
+
+def test_dem_run_prints_the_sdc_a_shaker_test_of_a_specimen_with_a_baseline_measures(
+        capsys, tmp_path):
+    # a calibrated file (fixture and baseline fitted) printed its Eq. 10 SDC and a note that
+    # the baseline adds 0.173: the number compared with a measurement, Eq. 11 of the virtual
+    # shaker SDC = 2 pi (d + eta_0 m_s) / (m_p + m_s), calibrate's prediction, was not shown
+    import math
+
+    from pidcore.calibrate.observation import observation_from_run
+    from pidcore.store import Store
+
+    damped = tmp_path / "damped.toml"
+    damped.write_text(STEEL.read_text().replace("baseline_loss_factor = 0.0",
+                                                "baseline_loss_factor = 0.02"))
+    store = tmp_path / "runs.h5"
+    assert main(["dem", "run", "--specimen", str(damped), "--frequency", "1000",
+                 "--acceleration", "5", "--cells", "1", "--cycles", "2", "--no-progress",
+                 "--store", str(store)]) == 0
+    out = capsys.readouterr().out
+    shown = float(re.search(r"^SDC measured    (\S+) \[-\]", out, re.M).group(1))
+    (key,) = Store(store).list_dem_runs()["case_key"]
+    entry = Store(store).get_dem_run(key)
+    spec = load_specimen(damped)
+    seen = observation_from_run(entry.record, entry.arrays, coupon_mass_kg=spec.coupon.mass_kg)
+    structure = spec.coupon.mass_kg + spec.coupon.fixture_mass_kg
+    truth = 2 * math.pi * (seen.dissipative_mass_kg + 0.02 * structure) / (
+        seen.reactive_mass_kg + structure)
+    assert shown == pytest.approx(truth, rel=5e-4)  # printed to 4 significant digits

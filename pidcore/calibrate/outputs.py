@@ -62,11 +62,41 @@ def specimen_text(result: CalibrationResult) -> str:
     if result.loo_rms is not None:
         lines.append(f"# leave-one-out RMS of the SDC: {rms_text(result.loo_rms)}")
     lines.append(f"# in-sample RMS of the SDC: {rms_text(result.rms)}")
+    if result.file_predicted:
+        lines.append(f"# {FILE_PREDICTS}:")
+        lines += [f"#   {' '.join(cells[:3])}: {cells[3]} (posterior median {cells[4]}, "
+                  f"{cells[5]})" for cells in file_prediction_rows(result)]
     measured = measured_words(result.settings.get("measured") or [])
     if measured:  # the tests it speaks for, by file and hash or by analysis keys
         lines.append(f"# {measured}")
     lines += [f"# note: {note}" for note in result.notes]  # e.g. a value set by its prior
     return "\n".join(lines) + "\n" + result.calibrated_specimen().to_toml()
+
+
+#: What :func:`file_prediction_rows` are, as the file's header and the summaries say it.
+FILE_PREDICTS = ("this file's own values (each parameter's posterior median) predict the SDC "
+                 "(Eq. 11, with its fixture and baseline; a DEM re-run of the file should "
+                 "give it, within the DEM's scatter), beside the calibration's posterior "
+                 "median of the SDC, which marginal medians of correlated parameters do not "
+                 "reproduce")
+#: Head of :func:`file_prediction_rows`' table in the summaries.
+FILE_PREDICTION_HEAD = ["frequency [Hz]", "acceleration [g]", "fill [%]",
+                        "calibrated file's values predict [-]",
+                        "SDC calibrated DEM, posterior median (Eq. 11) [-]",
+                        "file vs posterior median [%]"]
+
+
+def file_prediction_rows(result: CalibrationResult) -> list[list[str]]:
+    """Per load case: its frequency, acceleration and fill, the SDC the calibrated file's
+    values predict (:attr:`CalibrationResult.file_predicted`), the posterior median SDC, and
+    their difference in percent of the latter."""
+    from .prediction import sdc_text
+
+    return [[f"{r['frequency_hz']:g}", f"{r['acceleration_g']:g} g", f"{r['fill_percent']:g} %",
+             sdc_text(own), sdc_text(r["predicted"]),
+             f"{100 * (own - r['predicted']) / r['predicted']:+.1f} %"
+             if r["predicted"] > 0 else "-"]
+            for r, own in zip(result.predictions, result.file_predicted, strict=True)]
 
 
 def _band_text(low: float, high: float, bound: float | None = None) -> str:
@@ -239,6 +269,9 @@ def _summary_tables(result: CalibrationResult) -> list[tuple[str, list[str], lis
         tables.append((f"{title}: RMS {rms_text(rms)}, {coverage_text(verdicts)}",
                        _prediction_head(),
                        _table_rows(rows, row_sdc_bounds(result, rows), verdicts)))
+    if result.file_predicted:
+        tables.append((f"What the calibrated file predicts: {FILE_PREDICTS}",
+                       list(FILE_PREDICTION_HEAD), file_prediction_rows(result)))
     if any(s.kind == "dem" for s in result.specs):
         tables.append(("Energy per cycle per cell: starting specimen vs calibrated DEM",
                        list(_ENERGY_HEAD),

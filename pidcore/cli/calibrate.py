@@ -190,7 +190,7 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
         print(document_json(result.document()))
         print(f"pidcore calibrate: {said}", file=sys.stderr)
     else:
-        from ..calibrate.outputs import parameter_units, specimen_words
+        from ..calibrate.outputs import file_prediction_rows, parameter_units, specimen_words
         from ..calibrate.posterior import summary_texts
 
         print(specimen_words(result, full_hash=False))
@@ -201,6 +201,12 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
         # with its count, as summary.md heads its in-sample table
         print(f"in-sample RMS {rms_text(result.rms)}, "
               f"{coverage_text(result.band_verdicts(result.predictions))}")
+        if result.file_predicted:
+            rows = file_prediction_rows(result)
+            print("calibrated file's own values (each median) predict "
+                  + ", ".join(c[3] for c in rows) + " where the posterior median SDC is "
+                  + ", ".join(c[4] for c in rows) + " (a DEM re-run of the file should give "
+                  "the former; its header and the summary give each load case)")
         print(runs)
         if result.loo is not None:
             print(f"leave-one-out RMS {rms_text(result.loo_rms)}, "

@@ -477,6 +477,9 @@ def _print_run(args: argparse.Namespace, result, case, specimen, *, key: str | N
         print(json.dumps(out))
         return
     print(format_summary(result, reused=reused))
+    total = _measured_sdc_line(specimen, result)
+    if total:
+        print(total)
     for note in said:
         print(f"note            {note}")
     if key is not None:
@@ -508,6 +511,30 @@ def _baseline_note(specimen, result) -> str:
             f"(the empty coupon's damping: 2 pi x {eta:g} of the coupon and fixture's own "
             f"kinetic energy, {within}, i.e. {2 * math.pi * eta * share:.3g} in this "
             "SDC) is not in it; pidcore calibrate's prediction adds it")
+
+
+def _measured_sdc_line(specimen, result) -> str:
+    """The run's SDC as a shaker test of ``specimen`` measures it (Eq. 11 of the virtual
+    shaker, with the coupon and fixture's inertia and its ``baseline_loss_factor``: the
+    observation model :func:`pidcore.calibrate.calibrate` predicts), where the specimen states a
+    baseline; "" elsewhere. A calibrated file ran with its Eq. 10 SDC and a note that the
+    baseline adds 0.173 to it, and the number a user compares with a measurement was theirs
+    to add up (and not the sum: Eq. 10 divides by another mass)."""
+    if specimen is None or not specimen.coupon.baseline_loss_factor > 0:
+        return ""
+    from ..calibrate.observation import observation_from_run
+    from ..dem.persist import dem_run_entry
+
+    entry = dem_run_entry(result)
+    seen = observation_from_run(entry["record"], entry["arrays"],
+                                coupon_mass_kg=specimen.coupon.mass_kg)
+    value = float(seen.sdc(specimen.coupon.fixture_mass_kg,
+                           specimen.coupon.baseline_loss_factor))
+    return (f"SDC measured    {value:.4g} [-] (Eq. 11 of the virtual shaker with the coupon + "
+            f"fixture's {(specimen.coupon.mass_kg + specimen.coupon.fixture_mass_kg) * 1e3:.4g}"
+            f" g and baseline_loss_factor {specimen.coupon.baseline_loss_factor:g}: what a "
+            "shaker test of this specimen measures, and pidcore calibrate predicts; compare "
+            "a measurement with this one)")
 
 
 def _same_simulation_note(asked, result) -> str:
