@@ -1011,6 +1011,7 @@ def test_the_html_summary_carries_the_notes_of_the_markdown_one():
                                         units=dict, specimen=paper_specimen(),
                                         calibrated_specimen=paper_specimen, specs=[],
                                         correlations=[], energy_check=[], wall_s=0.0,
+                                        file_predicted=[],
                                         runs={"computed": 0, "cached": 0},
                                         settings={"cells": 2, "design_size": 1,
                                                   "method_used": "grid"}))

@@ -64,8 +64,8 @@ def specimen_text(result: CalibrationResult) -> str:
     lines.append(f"# in-sample RMS of the SDC: {rms_text(result.rms)}")
     if result.file_predicted:
         lines.append(f"# {FILE_PREDICTS}:")
-        lines += [f"#   {' '.join(cells[:3])}: {cells[3]} (posterior median {cells[4]}, "
-                  f"{cells[5]})" for cells in file_prediction_rows(result)]
+        lines += [f"#   {case}: {own} (posterior median {median}, {difference})"
+                  for case, own, median, difference in file_prediction_rows(result)]
     measured = measured_words(result.settings.get("measured") or [])
     if measured:  # the tests it speaks for, by file and hash or by analysis keys
         lines.append(f"# {measured}")
@@ -80,8 +80,7 @@ FILE_PREDICTS = ("this file's own values (each parameter's posterior median) pre
                  "median of the SDC, which marginal medians of correlated parameters do not "
                  "reproduce")
 #: Head of :func:`file_prediction_rows`' table in the summaries.
-FILE_PREDICTION_HEAD = ["frequency [Hz]", "acceleration [g]", "fill [%]",
-                        "calibrated file's values predict [-]",
+FILE_PREDICTION_HEAD = ["load case", "calibrated file's values predict [-]",
                         "SDC calibrated DEM, posterior median (Eq. 11) [-]",
                         "file vs posterior median [%]"]
 
@@ -92,7 +91,7 @@ def file_prediction_rows(result: CalibrationResult) -> list[list[str]]:
     their difference in percent of the latter."""
     from .prediction import sdc_text
 
-    return [[f"{r['frequency_hz']:g}", f"{r['acceleration_g']:g} g", f"{r['fill_percent']:g} %",
+    return [[f"{r['frequency_hz']:g} Hz, {r['acceleration_g']:g} g, {r['fill_percent']:g} %",
              sdc_text(own), sdc_text(r["predicted"]),
              f"{100 * (own - r['predicted']) / r['predicted']:+.1f} %"
              if r["predicted"] > 0 else "-"]

@@ -204,8 +204,8 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
         if result.file_predicted:
             rows = file_prediction_rows(result)
             print("calibrated file's own values (each median) predict "
-                  + ", ".join(c[3] for c in rows) + " where the posterior median SDC is "
-                  + ", ".join(c[4] for c in rows) + " (a DEM re-run of the file should give "
+                  + ", ".join(c[1] for c in rows) + " where the posterior median SDC is "
+                  + ", ".join(c[2] for c in rows) + " (a DEM re-run of the file should give "
                   "the former; its header and the summary give each load case)")
         print(runs)
         if result.loo is not None:
