@@ -810,3 +810,21 @@ def test_a_fit_that_reaches_sdcs_above_one_is_not_taken_for_percent():
         check_not_percent(points, [0.5, 2.0])
     # the same values as fractions of percent are left alone whatever the fit gives
     check_not_percent([dataclasses.replace(p, sdc=p.sdc / 100) for p in points], [1e-4, 1e-4])
+
+
+def test_a_prediction_above_the_sdc_bound_is_refused_naming_its_case_and_fold():
+    # the tester's leave-one-out fold at 200 Hz / 5 g predicted SDC 99.4 beside a band cut at
+    # 2 pi, and its RMS of 40.5 was written to the summary, the calibrated file and the store
+    # listing with exit 0; an SDC no measurement is kept at (above 2 pi here: the point's
+    # specimen is not known) is no prediction
+    point = MeasuredPoint(200, 5, 6, 0.269, 0.0144)
+    above = {"predicted": 99.4, "low95": -0.043, "high95": 8.6e7}
+    with pytest.raises(ParameterError) as refused:
+        calibrate_module._row(point, above, "leave-one-out")
+    message = str(refused.value)
+    assert "\n" not in message
+    assert "leave-one-out prediction at 200 Hz, 5 g, 6 %" in message
+    assert "99.4" in message and "2 pi = 6.283" in message
+    # at the bound itself it is a prediction (the bound is the largest SDC kept)
+    row = calibrate_module._row(point, {**above, "predicted": 2 * math.pi}, "in-sample")
+    assert row["error"] == pytest.approx(2 * math.pi - 0.269)

@@ -646,7 +646,8 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     notes += bound_notes(specs, samples, effective_size=posterior.effective_size)
     notes += unconstrained_notes(specs, samples)
     rng = np.random.default_rng(posterior_seed + 1)
-    predictions = [_row(points[i], predictive(model, samples, i, rng=rng)) for i in everything]
+    predictions = [_row(points[i], predictive(model, samples, i, rng=rng), "in-sample")
+                   for i in everything]
     check_not_percent(points, [r["predicted"] for r in predictions])
     file_predicted = file_predictions(model, parameters)
     energy = energy_check(model, samples, specimen)
@@ -669,7 +670,8 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
                     fold_fallbacks.append(points[i].label())
                 if not fold.converged:
                     fold_unconverged.append(points[i].label())
-                loo.append(_row(points[i], predictive(model, fold.samples, i, rng=rng)))
+                loo.append(_row(points[i], predictive(model, fold.samples, i, rng=rng),
+                                "leave-one-out"))
                 if bar is not None:
                     bar.update(1)
         finally:
@@ -769,9 +771,10 @@ def nonpositive_dissipation_notes(labels: Sequence[str],
                                   observations: Sequence[Sequence[Observation]]) -> list[str]:
     """A note per measured point whose DEM runs give no positive particle dissipation over
     their window (Re P <= 0: the bed gave back stored energy there, a window that is no
-    steady state). The surrogate takes such a run's dissipative mass as zero within its
-    standard error; that was silent, and a prediction of the baseline alone (0.024 where the
-    run's dissipation tally said 0.14) read as the model's."""
+    steady state). The surrogate takes such a run's dissipative mass as it is, with its
+    standard error (:func:`pidcore.calibrate.surrogate.build_surrogate`); that was silent,
+    and a prediction of the baseline alone (0.024 where the run's dissipation tally said
+    0.14) read as the model's."""
     notes = []
     for label, runs in zip(labels, observations, strict=True):
         found = [o for o in runs if not o.dissipative_mass_kg > 0]
@@ -782,8 +785,9 @@ def nonpositive_dissipation_notes(labels: Sequence[str],
                 + ", ".join(f"{o.dissipative_mass_kg:.3g} +- {o.dissipative_mass_stderr_kg:.2g}"
                             for o in found)
                 + " kg: the bed gave back stored energy, no steady state); the surrogate "
-                "takes their particle damping as 0 within that error, so the prediction there "
-                "may be low: give the runs more steady cycles or more cells")
+                "of this load case is of d itself, not log d, and takes them as they are with "
+                "that error (one of 0 +- 0 with the other runs' median error), so the "
+                "prediction there may be low: give the runs more steady cycles or more cells")
     return notes
 
 
@@ -832,7 +836,7 @@ def energy_check(model: Model, samples: np.ndarray, specimen: Specimen) -> list[
     return out
 
 
-def _row(point: MeasuredPoint, prediction: dict) -> dict:
+def _row(point: MeasuredPoint, prediction: dict, fold: str) -> dict:
     row = {"frequency_hz": point.frequency_hz, "acceleration_g": point.acceleration_g,
            "fill_percent": point.fill_percent, "material": point.material,
            "measured": point.sdc,
@@ -844,4 +848,14 @@ def _row(point: MeasuredPoint, prediction: dict) -> dict:
     row["error"] = row["predicted"] - point.sdc
     if not all(math.isfinite(row[k]) for k in ("predicted", "low95", "high95")):
         raise ParameterError(f"calibration: prediction at {point.label()} is not finite")
+    if row["predicted"] > point.sdc_bound.sdc:
+        from .prediction import band_cut_words
+
+        # an SDC no measurement is kept at is no prediction: 99.4 (bound 2 pi) went into the
+        # leave-one-out RMS (40.5) of the summary, the calibrated file and the store listing
+        raise ParameterError(
+            f"calibration: the {fold} prediction at {point.label()} is SDC "
+            f"{row['predicted']:.4g}, above {band_cut_words(point.sdc_bound)}: the DEM "
+            "surrogate there is not sound; give "
+            "the DEM runs more cells or steady cycles (--cells, --steady-cycles)")
     return row

@@ -6,11 +6,16 @@ DEM parameters' bounds; no DEM parameter -> one run per load case at the startin
 Surrogate: per load case, a Gaussian process of ``log d`` (dissipative mass) and of ``m_p``
 (reactive mass) over the design coordinates scaled to [0, 1]: constant mean, squared-
 exponential kernel, and the DEM runs' own standard errors (the ensemble scatter across cells
-and blocks) as known noise on each run. Kernel amplitude and length scale maximise the
-marginal likelihood over a small grid. Its predictive variance is the surrogate's uncertainty
-of the DEM's mean at a parameter value: small at a design point with many cells, larger
-between points where the response bends. With one run (no DEM parameter) it is that run's
-value and standard error.
+and blocks) as known noise on each run. ``log d`` only where every run resolves its d (d at
+least LOG_RESOLVED_STDERRS standard errors); else ``d`` itself, where a run that dissipates
+nothing (d <= 0 within its noise) is an observation like any other. A run stated without
+scatter (its cells agreed exactly, or its bed never touched a wall) takes the median standard
+error of the case's other runs: it is one more noisy estimate, not an exact value. Kernel
+amplitude and length scale maximise the marginal likelihood over a small grid. Its predictive
+variance is the surrogate's uncertainty of the DEM's mean at a parameter value: small at a
+design point with many cells, larger between points where the response bends (computed
+through the Cholesky factor, positive between noisy runs). With one run (no DEM parameter) it
+is that run's value and standard error.
 """
 
 from __future__ import annotations
@@ -25,8 +30,13 @@ import numpy as np
 from .observation import Observation
 from .parameters import ParameterSpec
 
-#: Smallest dissipative mass used in the log transform (kg): far below any measurable value.
-_MIN_DISSIPATIVE_MASS_KG = 1e-12
+#: A case's surrogate is of log d where every run's d is at least this many of its standard
+#: errors: the log's standard error se / d is then <= 1/3, where its first-order propagation
+#: holds (bias (se/d)^2 / 2 under 6 %). A run nearer 0 entered log space clamped to 1e-12 kg
+#: with a relative error of ~1e9 (or, one with no wall force at all, as an exact log d of
+#: -27.6): the kernel's amplitude went to ~1e15, d to 121 kg between the runs and its variance
+#: to exactly 0 at others.
+LOG_RESOLVED_STDERRS = 3.0
 #: Length scales (in units of the design range) and amplitude factors searched.
 _LENGTH_SCALES = (0.1, 0.2, 0.35, 0.6, 1.0, 2.0)
 _AMPLITUDES = tuple(10.0 ** np.linspace(-3, 1.5, 10))
@@ -71,33 +81,38 @@ class _Process:
     amplitude: float
     length: float
     weights: np.ndarray  # (K + N)^-1 (y - mean)
-    inverse: np.ndarray  # (K + N)^-1
+    whitening: np.ndarray  # L^-1, L the lower Cholesky factor of K + N
     constant_variance: float
 
     def predict(self, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        if self.u.shape[1] == 0:
+        if self.u.shape[1] == 0 or self.amplitude == 0.0:
             n = u.shape[0]
             return np.full(n, self.mean), np.full(n, self.constant_variance)
         k = self.amplitude * _kernel(u, self.u, self.length)
         mean = self.mean + k @ self.weights
-        var = self.amplitude - np.einsum("ij,jk,ik->i", k, self.inverse, k)
+        # k (K + N)^-1 k as |L^-1 k|^2, a sum of squares: through the explicit inverse it
+        # cancelled to below 0 (clipped to an exact 0) between noisy runs. L^-1 once per fit,
+        # not a triangular solve per call: the grid posterior calls this thousands of times
+        v = self.whitening @ k.T
+        var = self.amplitude - np.sum(v * v, axis=0)
         # the constant mean is estimated too (universal kriging): its variance where the
         # runs do not pin the prediction down
-        ones = np.ones(self.u.shape[0])
-        precision = ones @ self.inverse @ ones
-        var = var + (1.0 - k @ (self.inverse @ ones)) ** 2 / precision
-        return mean, np.maximum(var, 0.0)
+        w = self.whitening.sum(axis=1)
+        var = var + (1.0 - v.T @ w) ** 2 / (w @ w)
+        return mean, np.maximum(var, 0.0)  # a sum of squares: only rounding takes it below
 
 
 def _fit(u: np.ndarray, y: np.ndarray, se: np.ndarray) -> _Process:
+    from scipy.linalg import cho_solve, solve_triangular
+
     n, d = u.shape
     noise = np.maximum(se**2, 1e-12 * max(float(np.var(y)), 1e-30))
     if d == 0 or n == 1:
         w = 1.0 / noise
         mean = float(np.sum(w * y) / np.sum(w))
-        return _Process(u, mean, 0.0, 1.0, np.zeros(n), np.zeros((n, n)),
-                        float(1.0 / np.sum(w)))
+        return _Process(u, mean, 0.0, 1.0, np.zeros(n), np.eye(n), float(1.0 / np.sum(w)))
     scale = max(float(np.var(y)), float(np.mean(noise)), 1e-30)
+    ones = np.ones(n)
     best = None
     for length in _LENGTH_SCALES:
         base = _kernel(u, u, length)
@@ -108,17 +123,29 @@ def _fit(u: np.ndarray, y: np.ndarray, se: np.ndarray) -> _Process:
                 chol = np.linalg.cholesky(cov)
             except np.linalg.LinAlgError:
                 continue
-            inv = np.linalg.inv(cov)
-            ones = np.ones(n)
-            mean = float(ones @ inv @ y / (ones @ inv @ ones))
+            solved_ones = cho_solve((chol, True), ones)
+            mean = float(solved_ones @ y / (ones @ solved_ones))
             r = y - mean
-            logml = -0.5 * r @ inv @ r - np.sum(np.log(np.diag(chol)))
+            weights = cho_solve((chol, True), r)
+            logml = -0.5 * r @ weights - np.sum(np.log(np.diag(chol)))
             if best is None or logml > best[0]:
-                best = (logml, amplitude, length, mean, inv, nugget)
-    _, amplitude, length, mean, inv, nugget = best
+                best = (logml, amplitude, length, mean, chol, weights)
+    _, amplitude, length, mean, chol, weights = best
     # the nugget is scatter of the runs, not of the DEM's mean: it widens the fit (through
-    # the inverse) but is not added to the predictive variance of the mean
-    return _Process(u, mean, amplitude, length, inv @ (y - mean), inv, 0.0)
+    # the factor) but is not added to the predictive variance of the mean
+    return _Process(u, mean, amplitude, length, weights,
+                    solve_triangular(chol, np.eye(n), lower=True), 0.0)
+
+
+def _stated_stderr(se: np.ndarray) -> np.ndarray:
+    """The runs' standard errors, where a run without scatter (0: its cells agreed exactly,
+    or its bed never touched a wall) takes the median of the others': as an exact value it
+    pinned the surrogate through it. Unchanged where no run states any scatter."""
+    se = np.asarray(se, dtype=float)
+    stated = se[np.isfinite(se) & (se > 0)]
+    if stated.size == 0:
+        return se
+    return np.where(np.isfinite(se) & (se > 0), se, float(np.median(stated)))
 
 
 @dataclass(frozen=True)
@@ -131,7 +158,9 @@ class CaseSurrogate:
     coupon_mass_kg: float
     low: np.ndarray
     high: np.ndarray
-    log_dissipative: _Process
+    dissipative: _Process
+    #: whether :attr:`dissipative` is of log d (every run resolved its d) or of d itself
+    logarithmic: bool
     reactive: _Process
 
     def predict(self, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray,
@@ -142,10 +171,12 @@ class CaseSurrogate:
             u = np.zeros((theta.shape[0], 0))
         else:
             u = (theta - self.low) / (self.high - self.low)
-        log_d, var_log_d = self.log_dissipative.predict(u)
+        d, var_d = self.dissipative.predict(u)
         m_p, var_m = self.reactive.predict(u)
-        d = np.exp(log_d)
-        return d, d**2 * var_log_d, m_p, var_m
+        if self.logarithmic:
+            d = np.exp(d)
+            var_d = d**2 * var_d
+        return d, var_d, m_p, var_m
 
 
 def build_surrogate(observations: Sequence[Observation], theta: np.ndarray,
@@ -156,15 +187,18 @@ def build_surrogate(observations: Sequence[Observation], theta: np.ndarray,
     low = np.array([s.low for s in specs]) if d else np.zeros(0)
     high = np.array([s.high for s in specs]) if d else np.ones(0)
     u = (theta - low) / (high - low) if d else np.zeros((n, 0))
-    dm = np.array([max(o.dissipative_mass_kg, _MIN_DISSIPATIVE_MASS_KG) for o in observations])
-    dm_se = np.array([o.dissipative_mass_stderr_kg for o in observations])
+    dm = np.array([o.dissipative_mass_kg for o in observations])
+    dm_se = _stated_stderr([o.dissipative_mass_stderr_kg for o in observations])
     mp = np.array([o.reactive_mass_kg for o in observations])
-    mp_se = np.array([o.reactive_mass_stderr_kg for o in observations])
+    mp_se = _stated_stderr([o.reactive_mass_stderr_kg for o in observations])
+    # the log only where no run's d is near 0 within its noise (a run of d <= 0 has no log)
+    logarithmic = bool(np.all(dm > 0) and np.all(dm >= LOG_RESOLVED_STDERRS * dm_se))
+    dissipative = (_fit(u, np.log(dm), dm_se / dm) if logarithmic else _fit(u, dm, dm_se))
     first = observations[0]
     return CaseSurrogate(
         frequency_hz=first.frequency_hz, acceleration_g=first.acceleration_g,
         fill_percent=first.fill_percent, coupon_mass_kg=first.coupon_mass_kg,
-        low=low, high=high, log_dissipative=_fit(u, np.log(dm), dm_se / dm),
+        low=low, high=high, dissipative=dissipative, logarithmic=logarithmic,
         reactive=_fit(u, mp, mp_se))
 
 
