@@ -820,11 +820,11 @@ def test_a_prediction_above_the_sdc_bound_is_refused_naming_its_case_and_fold():
     point = MeasuredPoint(200, 5, 6, 0.269, 0.0144)
     above = {"predicted": 99.4, "low95": -0.043, "high95": 8.6e7}
     with pytest.raises(ParameterError) as refused:
-        calibrate_module._row(point, above, "leave-one-out")
+        calibrate_module._row(point, above, fold="leave-one-out")
     message = str(refused.value)
     assert "\n" not in message
     assert "leave-one-out prediction at 200 Hz, 5 g, 6 %" in message
     assert "99.4" in message and "2 pi = 6.283" in message
     # at the bound itself it is a prediction (the bound is the largest SDC kept)
-    row = calibrate_module._row(point, {**above, "predicted": 2 * math.pi}, "in-sample")
+    row = calibrate_module._row(point, {**above, "predicted": 2 * math.pi})
     assert row["error"] == pytest.approx(2 * math.pi - 0.269)

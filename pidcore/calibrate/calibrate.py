@@ -646,8 +646,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
     notes += bound_notes(specs, samples, effective_size=posterior.effective_size)
     notes += unconstrained_notes(specs, samples)
     rng = np.random.default_rng(posterior_seed + 1)
-    predictions = [_row(points[i], predictive(model, samples, i, rng=rng), "in-sample")
-                   for i in everything]
+    predictions = [_row(points[i], predictive(model, samples, i, rng=rng)) for i in everything]
     check_not_percent(points, [r["predicted"] for r in predictions])
     file_predicted = file_predictions(model, parameters)
     energy = energy_check(model, samples, specimen)
@@ -671,7 +670,7 @@ def calibrate(points: Sequence[MeasuredPoint], *, fit: str | Sequence[str],
                 if not fold.converged:
                     fold_unconverged.append(points[i].label())
                 loo.append(_row(points[i], predictive(model, fold.samples, i, rng=rng),
-                                "leave-one-out"))
+                                fold="leave-one-out"))
                 if bar is not None:
                     bar.update(1)
         finally:
@@ -836,7 +835,7 @@ def energy_check(model: Model, samples: np.ndarray, specimen: Specimen) -> list[
     return out
 
 
-def _row(point: MeasuredPoint, prediction: dict, fold: str) -> dict:
+def _row(point: MeasuredPoint, prediction: dict, fold: str = "in-sample") -> dict:
     row = {"frequency_hz": point.frequency_hz, "acceleration_g": point.acceleration_g,
            "fill_percent": point.fill_percent, "material": point.material,
            "measured": point.sdc,
@@ -856,6 +855,6 @@ def _row(point: MeasuredPoint, prediction: dict, fold: str) -> dict:
         raise ParameterError(
             f"calibration: the {fold} prediction at {point.label()} is SDC "
             f"{row['predicted']:.4g}, above {band_cut_words(point.sdc_bound)}: the DEM "
-            "surrogate there is not sound; give "
-            "the DEM runs more cells or steady cycles (--cells, --steady-cycles)")
+            "surrogate there is not sound; give the DEM runs more cells or more steady "
+            "cycles")
     return row

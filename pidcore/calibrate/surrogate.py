@@ -99,7 +99,7 @@ class _Process:
         # runs do not pin the prediction down
         w = self.whitening.sum(axis=1)
         var = var + (1.0 - v.T @ w) ** 2 / (w @ w)
-        return mean, np.maximum(var, 0.0)  # a sum of squares: only rounding takes it below
+        return mean, np.maximum(var, 0.0)  # >= 0 exactly; rounding may take it a hair below
 
 
 def _fit(u: np.ndarray, y: np.ndarray, se: np.ndarray) -> _Process:
