@@ -117,15 +117,20 @@ def _table(frame: pd.DataFrame) -> str:
 
 
 def run_verify(args: argparse.Namespace) -> int:
+    from ..errors import StoreError
     from ..store.manage import existing_store, verify_with_progress
 
     store = existing_store(args.store)
     problems = verify_with_progress(store, progress=progress_wanted(args),
                                     label=f"verifying {args.store}")
     summary = store.summary()
+    try:
+        unchecked = store.unchecked()
+    except StoreError:  # a store too damaged to say: its problems are printed
+        unchecked = []
     if args.json:
         print(json.dumps({"store": str(args.store), "sound": not problems,
-                          "problems": problems, "summary": summary}))
+                          "problems": problems, "unchecked": unchecked, "summary": summary}))
     elif problems:
         print("\n".join(problems))
         print(f"{args.store}: damaged: {len(problems)} problem(s)", file=sys.stderr)
@@ -134,6 +139,8 @@ def run_verify(args: argparse.Namespace) -> int:
               f"{summary['n_analyses']} analysis(es), {summary['n_dem_runs']} DEM run(s), "
               f"{summary['n_calibrations']} calibration(s); every array read and its "
               "checksum checked)")
+    if unchecked and not args.json:
+        print("\n".join(unchecked))
     return DAMAGED_EXIT if problems else 0
 
 

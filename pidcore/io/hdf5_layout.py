@@ -57,10 +57,15 @@ def write_measurement_group(group: h5py.Group, measurement: Measurement) -> None
     group.attrs["sha256"] = measurement.sha256
     group.attrs["file_format"] = measurement.file_format
     group.attrs["metadata_json"] = json.dumps(dict(measurement.metadata), default=str)
-    channels = group.create_group("channels")
+    # track_order makes HDF5 write version-2 object headers, which carry a checksum that
+    # every read checks: a bit flipped in a channel's sample_rate_hz (25600 -> 27648) was read
+    # as it stood (54 Hz for 50 Hz) where the same flip in an analysis's record is refused.
+    # The caller creates ``group`` the same way (:func:`metadata_checksummed`).
+    channels = group.create_group("channels", track_order=True)
     for order, ch in enumerate(measurement.channels):
         ds = channels.create_dataset(f"{order:03d}", data=_stored_samples(ch.data),
-                                     compression="gzip", compression_opts=4, shuffle=True)
+                                     compression="gzip", compression_opts=4, shuffle=True,
+                                     track_order=True)
         ds.attrs["name"] = ch.name
         ds.attrs["quantity"] = ch.quantity
         ds.attrs["unit"] = ch.unit
@@ -70,12 +75,26 @@ def write_measurement_group(group: h5py.Group, measurement: Measurement) -> None
         ds.attrs["order"] = order
 
 
+def metadata_checksummed(obj: h5py.Group | h5py.Dataset) -> bool:
+    """Whether HDF5 checks a checksum of ``obj``'s attributes and links on every read (a
+    version-2 object header, which :func:`write_measurement_group` writes; earlier pidcore
+    versions wrote version 1, without one)."""
+    return h5py.h5o.get_info(obj.id).hdr.version >= 2
+
+
 def _text(value: object) -> str:
     return value.decode("utf-8", "replace") if isinstance(value, bytes) else str(value)
 
 
 def _channel_dataset(channels: h5py.Group, key: str, where: str) -> h5py.Dataset:
-    item = channels.get(key)  # None for a soft link to nothing
+    # opened where hard-linked, so a header failing its checksum is HDF5's error, not None
+    # (then "a link to nothing"); get() is None for a soft link to nothing
+    link = channels.get(key, getlink=True)
+    try:
+        item = channels[key] if isinstance(link, h5py.HardLink) else channels.get(key)
+    except KeyError as exc:  # h5py's KeyError for an object HDF5 could not open
+        raise InputFileError(f"{where}/channels/{key}: cannot be read "
+                             f"({exc.args[0] if exc.args else exc})") from None
     if not isinstance(item, h5py.Dataset):
         what = "a link to nothing" if item is None else "a group"
         raise InputFileError(f"{where}/channels/{key}: is {what}; expected a dataset of samples")
