@@ -139,7 +139,7 @@ def run_verify(args: argparse.Namespace) -> int:
               f"{summary['n_analyses']} analysis(es), {summary['n_dem_runs']} DEM run(s), "
               f"{summary['n_calibrations']} calibration(s); every array read and its "
               "checksum checked)")
-    if unchecked and not args.json:
+    if unchecked and not problems and not args.json:
         print("\n".join(unchecked))
     return DAMAGED_EXIT if problems else 0
 

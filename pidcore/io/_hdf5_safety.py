@@ -33,8 +33,10 @@ MAX_DEPTH = 32
 MAX_OBJECTS = 100_000
 
 
-def _walk(group: h5py.Group, where: str, depth: int, counter: list[int]) -> int:
-    """Declared bytes of the datasets below ``group``; raises on links out of the file."""
+def _walk(group: h5py.Group, where: str, depth: int, counter: list[int], *,
+          own_objects: bool = False) -> int:
+    """Declared bytes of the datasets below ``group``; raises on links out of the file, and
+    with ``own_objects`` on any soft link and any object linked under another name too."""
     if depth > MAX_DEPTH:
         raise InputFileError(f"{where}: groups nested deeper than {MAX_DEPTH} levels at "
                              f"{group.name!r}; refused (a group linked into itself?)")
@@ -50,10 +52,16 @@ def _walk(group: h5py.Group, where: str, depth: int, counter: list[int]) -> int:
                                  f"{link.filename!r}; refused: a file from elsewhere must not make "
                                  "pidcore read other files")
         if isinstance(link, h5py.SoftLink):
+            if own_objects:
+                raise InputFileError(f"{where}: {path!r} is a soft link to {link.path!r}; "
+                                     "expected an object of its own (a link may lead out of it, "
+                                     "to another record or to another file)")
             continue  # a path inside this file; its target is walked where it lives
         obj = group.get(name)
+        if own_objects and obj is not None:
+            _refuse_shared(obj, path, where)
         if isinstance(obj, h5py.Group):
-            total += _walk(obj, where, depth + 1, counter)
+            total += _walk(obj, where, depth + 1, counter, own_objects=own_objects)
         elif isinstance(obj, h5py.Dataset):
             if obj.is_virtual:
                 raise InputFileError(f"{where}: dataset {path!r} is a virtual dataset (data "
@@ -75,18 +83,30 @@ def _walk(group: h5py.Group, where: str, depth: int, counter: list[int]) -> int:
     return total
 
 
+def _refuse_shared(obj: h5py.Group | h5py.Dataset, path: str, where: str) -> None:
+    links = h5py.h5o.get_info(obj.id).rc
+    if links > 1:
+        raise InputFileError(f"{where}: {path!r} is linked under {links} names in the file "
+                             "(shared with another record); expected an object of its own")
+
+
 def check_self_contained(group: h5py.Group, *, where: str) -> None:
     """Refuse what below ``group`` would make HDF5 read other files or load a plugin library
     (external links, external storage, virtual datasets, filters not built in), before any
     dataset below it is read: :func:`check_hdf5_input` for one part of an open file (an entry
     of a store, whose whole walk on every open would cost more than the reads it guards).
+    ``group`` holds its own objects only, at any depth: a soft link (one to a root link to
+    another file made get_dem_run read that file; one to another record's array gave its
+    values) and an object hard-linked under a second name (another record's too) are
+    refused as well.
 
     Raises
     ------
     InputFileError
         Naming ``where`` and the offending object.
     """
-    _walk(group, where, 0, [0])
+    _refuse_shared(group, group.name, where)
+    _walk(group, where, 0, [0], own_objects=True)
 
 
 def check_hdf5_input(path: str | os.PathLike[str], *, what: str = "HDF5") -> None:

@@ -575,6 +575,13 @@ class Store:
             raise StoreError(f"{self.path}: store version {version} is newer than this pidcore "
                              f"({__version__}) understands (version {STORE_VERSION}); "
                              "upgrade pidcore")
+        for name in h5:
+            # a link at the root leads out of the store's own objects (/zz = an external link
+            # that an entry's soft link pointed at), whatever its name
+            link = h5.get(name, getlink=True)
+            if not isinstance(link, h5py.HardLink):
+                raise self._unreadable(f"/{name} is {self._what(link, None)}; expected the "
+                                       f"store's own groups at its root ({', '.join(_SECTIONS)})")
         if every_entry:
             self._check_sections(h5)
 
@@ -1196,6 +1203,18 @@ class Store:
                                  f"{', '.join(_SECTIONS)})")
             check_name(key, what="key", where=str(self.path))
         with self.transaction() as h5:
+            # a record linked into another (a soft link, a dataset of two names) is damage that
+            # removing one of them spreads to the other (its link left to nothing), or
+            # hides: refused, as verify names it
+            for section in _SECTIONS:
+                parent = self._section(h5, section)
+                for name in () if parent is None else parent:
+                    try:
+                        check_self_contained(self._entry_of(parent, section, name),
+                                             where=f"{self.path}:/{section}/{name}")
+                    except InputFileError as exc:
+                        raise StoreError(f"{exc}; nothing was removed (`pidcore store verify` "
+                                         "names what is damaged)") from None
             for section, key in entries:
                 if self._stored_entry(h5, section, key) is None:
                     raise StoreError(f"{self.path}: no entry {key!r} in /{section}; nothing "
