@@ -738,9 +738,10 @@ def _joined_dem_runs(stores: list) -> pd.DataFrame | None:
     first); None without a store."""
     if not stores:
         return None
+    from ..store.listing import checked_dem_runs, list_dem_runs
+
     if len(stores) == 1:
-        return stores[0].list_dem_runs()
-    from ..store.listing import list_dem_runs
+        return checked_dem_runs(stores[0].list_dem_runs(), stores[0].path)
 
     return list_dem_runs(*(s.path for s in stores))
 

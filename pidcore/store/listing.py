@@ -78,6 +78,50 @@ def analysis_row_problems(row: pd.Series) -> list[str]:
     return problems
 
 
+def dem_run_row_problems(row: pd.Series) -> list[str]:
+    """What a stored DEM run's result fields (a row of :meth:`Store.list_dem_runs`) hold that
+    no run saves: an SDC that is not a finite number >= 0 (a run's is its dissipation over
+    the peak kinetic energy), or one other than 2 pi x its loss factor or its
+    energy_per_cycle_j / max_kinetic_energy_j (:meth:`pidcore.dem.result.DemResult.
+    from_tallies` makes both from the same numbers: equal but for rounding). An SDC of -0.5
+    was printed as "SDC DEM (ours)", and a NaN one interpolated over without a note."""
+    sdc = row.get("sdc")
+    if sdc is None:  # not stored: the run is no result a report reads
+        return []
+    value = _float(sdc)
+    if isinstance(sdc, bool | str) or not (math.isfinite(value) and value >= 0):
+        return [f"record field sdc = {sdc!r} is not a finite number >= 0"]
+    problems = []
+    loss, energy, peak = (_float(row.get(name)) for name in
+                          ("loss_factor", "energy_per_cycle_j", "max_kinetic_energy_j"))
+    # rel_tol 1e-9: both ways of computing differ by a few ulp (2e-16 over the Table 3 grid)
+    if math.isfinite(loss) and not math.isclose(value, 2 * math.pi * loss, rel_tol=1e-9,
+                                                abs_tol=1e-15):
+        problems.append(f"record field sdc = {value!r} is not 2 pi x its loss_factor {loss!r}")
+    if math.isfinite(energy) and math.isfinite(peak) and peak > 0 and not math.isclose(
+            value, energy / peak, rel_tol=1e-9, abs_tol=1e-15):
+        problems.append(f"record field sdc = {value!r} is not its energy_per_cycle_j / "
+                        f"max_kinetic_energy_j ({energy / peak:.6g}), as a run saves it")
+    return problems
+
+
+def checked_dem_runs(runs: pd.DataFrame, where: str | os.PathLike) -> pd.DataFrame:
+    """``runs`` (a :meth:`Store.list_dem_runs` listing of the store ``where``) if every run's
+    result fields hold what a run saves (:func:`dem_run_row_problems`), else
+    :class:`StoreError` naming the store, the run and the field."""
+    for _, row in runs.iterrows():
+        problems = dem_run_row_problems(row)
+        if problems:
+            raise damaged_dem_run(where, row, problems[0])
+    return runs
+
+
+def damaged_dem_run(where: str | os.PathLike, row: pd.Series, what: str) -> StoreError:
+    """The refusal of a DEM run changed outside pidcore, naming the store and the run."""
+    return StoreError(f"{where}: DEM run {row.get('case_key', '')}: {what}; it was changed or "
+                      "damaged outside pidcore (run it again into a fresh store)")
+
+
 def damaged_analysis(where: str | os.PathLike, row: pd.Series, what: str) -> StoreError:
     """The refusal of a record changed outside pidcore, naming the store and the record."""
     name = Path(str(row.get("source", "") or "")).name or row.get("key", "")
@@ -102,7 +146,7 @@ def list_dem_runs(*paths: str | os.PathLike | None) -> pd.DataFrame:
     frames = []
     for where in paths:
         if where is not None and Path(where).is_file():
-            runs = Store(where).list_dem_runs()
+            runs = checked_dem_runs(Store(where).list_dem_runs(), where)
             if not runs.empty:
                 frames.append(runs.assign(store=str(where)))
     if not frames:

@@ -1368,7 +1368,8 @@ class Store:
                         problems.append(f"{where}: unreadable ({type(exc).__name__}: {exc})")
         finally:
             h5.close()
-        return problems + self._analysis_values() + self._missing_design_runs()
+        return problems + self._analysis_values() + self._dem_run_values() + \
+            self._missing_design_runs()
 
     def _analysis_values(self) -> list[str]:
         """Analyses whose result fields hold what no analysis saves (an SDC of NaN or not
@@ -1384,6 +1385,19 @@ class Store:
             return []
         return [str(damaged_analysis(self.path, row, problem))
                 for _, row in analyses.iterrows() for problem in analysis_row_problems(row)]
+
+    def _dem_run_values(self) -> list[str]:
+        """DEM runs whose SDC is no result a run saves (negative, NaN, not 2 pi x its loss
+        factor nor its energy per cycle over its peak kinetic energy), refused by reports
+        (:func:`pidcore.store.listing.dem_run_row_problems`); as :meth:`_analysis_values`."""
+        from .listing import damaged_dem_run, dem_run_row_problems
+
+        try:
+            runs = self.list_dem_runs()
+        except StoreError:
+            return []
+        return [str(damaged_dem_run(self.path, row, problem))
+                for _, row in runs.iterrows() for problem in dem_run_row_problems(row)]
 
     def _missing_design_runs(self) -> list[str]:
         """A calibration whose design runs were removed without it (a run shared by two
