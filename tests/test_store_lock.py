@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import threading
 import time
 
@@ -131,3 +133,21 @@ def test_an_interrupt_as_the_lock_is_released_still_frees_it(tmp_path, monkeypat
     with exclusive_lock(path, timeout_s=0):  # free at once, in this very process
         pass
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_a_store_another_program_holds_open_is_said_to_be_open_not_damaged(tmp_path):
+    path = tmp_path / "s.h5"
+    Store(path).add_dem_run("a", {"sdc": 0.1})
+    holder = subprocess.Popen(
+        [sys.executable, "-c", "import h5py, sys, time; f = h5py.File(sys.argv[1], 'r+'); "
+         "print('open', flush=True); time.sleep(60)", str(path)],
+        stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "open"
+        with pytest.raises(StoreError) as refused:
+            Store(path)
+    finally:
+        holder.kill()
+        holder.wait()
+    said = str(refused.value)
+    assert "another program has the store open" in said and "not a readable" not in said

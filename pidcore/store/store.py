@@ -551,6 +551,13 @@ class Store:
             # h5py's "Unable to synchronously open file (...)" is HDF5's wording for a file
             # of another kind: say that in the user's terms
             said = "not an HDF5 file: a store is the .h5 file pidcore writes"
+        if "unable to lock file" in said and "errno = 11" in said:
+            # HDF5's own file lock (EAGAIN): a program holds the file open to write, which
+            # says nothing of the store being damaged
+            return StoreError(f"{self.path}: another program has the store open (HDF5 could "
+                              "not lock it: errno 11, resource temporarily unavailable); "
+                              "expected it free: close that program, or wait for it, and "
+                              "try again")
         return StoreError(f"{self.path}: not a readable pidcore store ({said})")
 
     def _check_root(self, h5: h5py.File, *, every_entry: bool = True) -> None:
