@@ -4,6 +4,7 @@ out of the file or to nothing) is refused in one line, read by nothing and never
 from __future__ import annotations
 
 import hashlib
+import os
 
 import h5py
 import numpy as np
@@ -113,3 +114,12 @@ def test_the_store_among_the_files_is_refused_before_it_is_read(tmp_path, capsys
         assert "--key" not in err
         assert _digest(store) == before
     assert len(Store(store).list_measurements()) == 2
+
+
+def test_a_store_path_that_is_a_loop_of_symbolic_links_is_refused_and_the_links_kept(tmp_path):
+    loop_a, loop_b = tmp_path / "loopA.h5", tmp_path / "loopB.h5"
+    loop_a.symlink_to(loop_b.name)
+    loop_b.symlink_to(loop_a.name)
+    with pytest.raises(StoreError, match=r"loopA\.h5: is a symbolic link that leads in a loop"):
+        Store(loop_a).add_dem_run("a", {"sdc": 0.1})
+    assert loop_a.is_symlink() and os.readlink(loop_a) == loop_b.name

@@ -40,6 +40,7 @@ works, instead of waiting for it.
 
 from __future__ import annotations
 
+import errno
 import io
 import json
 import os
@@ -435,6 +436,16 @@ class Store:
         if self.path.is_dir():  # HDF5's own message is two lines of C-library internals
             raise StoreError(f"{self.path}: is a folder; expected a store file (e.g. "
                              f"{defaults.STORE_PATH})")
+        if self.path.is_symlink():
+            try:
+                os.stat(self.path)
+            except OSError as exc:
+                # exists() is False for a loop (a -> b -> a), so the first save replaced the
+                # link with a new store; a dangling link is a store yet to be made, kept
+                if exc.errno == errno.ELOOP:
+                    raise StoreError(f"{self.path}: is a symbolic link that leads in a loop "
+                                     "(too many levels of links); expected a store file or a "
+                                     "link to one") from None
         if self.path.exists():
             with self._reading():
                 pass  # refuse a corrupt or foreign file now rather than at first use
