@@ -25,6 +25,13 @@ class _OneLineParser(argparse.ArgumentParser):
     """Usage errors as one line naming the sub-command (``pidcore analyze: error: ...``), exit 2;
     the usage stays one ``--help`` away. Sub-parsers inherit the class."""
 
+    def __init__(self, *args, **kwargs) -> None:
+        # no prefixes of long options: `--mass 0.003` ran as --mass-below-gauge and
+        # `store remove --with` as --with-dependents, and an option added later would
+        # silently change what an old abbreviation means
+        kwargs["allow_abbrev"] = False
+        super().__init__(*args, **kwargs)
+
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
