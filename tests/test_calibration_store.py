@@ -507,3 +507,51 @@ def test_a_calibrations_stored_settings_are_read_by_one_reader():
     for damaged in (None, "", float("nan"), "{broken", "[1, 2]", '{"settings": [3]}',
                     '{"other": {}}'):
         assert stored_settings(damaged) == {}, damaged
+
+
+def _printed_report_line(said: str) -> list[str] | None:
+    """The `pidcore report ...` calibrate printed to paste, as the shell splits it."""
+    import re
+    import shlex
+
+    lines = re.findall(r"\((pidcore report [^()]*)\)$", said, re.M)
+    return shlex.split(lines[0]) if lines else None
+
+
+def test_the_report_line_calibrate_prints_shows_the_calibrated_load_cases(
+        calibrated, capsys, tmp_path, monkeypatch):
+    folder, store = calibrated
+    copy = tmp_path / "dem.h5"
+    copy.write_bytes(store.read_bytes())
+    line = _printed_report_line(_calibrate(folder, copy, "0.3", capsys))
+    monkeypatch.chdir(tmp_path)  # as pasted: --out report_out is made where the user is
+    assert main([*line[1:], "--format", "csv"]) == 0
+    table = pd.read_csv(tmp_path / "report_out" / "report.csv")
+    # a row of each of the table's 3 load cases, each with the calibration's prediction
+    assert sorted(zip(table["frequency [Hz]"], table["acceleration [g]"], strict=True)) == \
+        [(500.0, 1.0), (500.0, 5.0), (1000.0, 5.0)]
+    assert np.isfinite(table["SDC calibrated DEM (Eq. 11) [-]"]).all()
+
+
+def test_a_fit_of_a_dem_parameter_to_a_table_prints_no_report_line_of_no_rows(
+        capsys, tmp_path, monkeypatch):
+    # the line printed, run as pasted, reported "(no load cases)" and exit 0: the design runs
+    # of a DEM parameter are variants of the specimen, which a report leaves out, and the
+    # --data table is no report input
+    table = tmp_path / "m.csv"
+    table.write_text(ROWS)
+    store = tmp_path / "dem.h5"
+    assert main(["calibrate", "--data", str(table), "--fit", "rolling_friction",
+                 "--design-size", "3", "--discrepancy", "0.2", "--dem-store", str(store),
+                 *TINY]) == 0
+    said = capsys.readouterr().out
+    key = Store(store).list_calibrations()["key"].iloc[0]
+    assert _printed_report_line(said) is None, said
+    assert (f"saved calibration {key} in {store} (no report line to paste: its DEM runs are "
+            "variants of the specimen") in said
+    assert f"--calibration {store} --calibration-key {key} shows them" in said
+    # what the line would have been does report nothing: the refusal hides no report of rows
+    monkeypatch.chdir(tmp_path)
+    assert main(["report", "--dem-store", str(store), "--calibration", str(store),
+                 "--calibration-key", key, "--out", "r", "--format", "csv"]) == 0
+    assert pd.read_csv(tmp_path / "r" / "report.csv").empty

@@ -267,12 +267,20 @@ class RunTally:
         calibrated as such), e.g. ``"2 of mycoupon [65a6d7]: calibration variant of mycoupon
         [072027] (static_friction 0.325, rolling_friction 0.025), ..."``; "" where none."""
         from ..compare.specimens import runs_per_specimen_text
+
+        runs = self.stored_runs()
+        return runs_per_specimen_text(runs) if runs is not None else ""
+
+    def stored_runs(self):
+        """The store's listing (:meth:`pidcore.store.Store.list_dem_runs`) of the design's
+        runs it holds; None where it holds none."""
         from ..store import Store
 
         if not self.keys or not Path(self.store_path).exists():
-            return ""
+            return None
         runs = Store(self.store_path).list_dem_runs()
-        return runs_per_specimen_text(runs[runs["case_key"].isin(self.keys)])
+        runs = runs[runs["case_key"].isin(self.keys)]
+        return runs if not runs.empty else None
 
     def interrupted(self) -> str:
         """What an interrupted calibration kept, e.g. ``"3 DEM run(s) finished before the

@@ -131,7 +131,7 @@ def run(args: argparse.Namespace) -> int:
         for note in left_out:
             print(f"pidcore calibrate: note: {cli_words(note, 'calibrate')}", file=sys.stderr)
     tally = RunTally(args.dem_store)
-    written, fitted, saved = False, False, None
+    written, fitted, saved, unreported = False, False, None, ""
     try:
         result = calibrate(points, fit=fit, priors=args.prior, discrepancy=args.discrepancy,
                            discrepancy_floor=args.discrepancy_floor, store_path=args.dem_store,
@@ -142,6 +142,7 @@ def run(args: argparse.Namespace) -> int:
                            on_design=tally.design)
         own_notes = list(result.notes)
         result.notes = [*left_out, *own_notes]
+        unreported = _unreported(args, tally, specimen)
         fitted = True
         if args.out is not None:
             # all or nothing; its notes in the words printed below (--prior, not priors=)
@@ -154,7 +155,7 @@ def run(args: argparse.Namespace) -> int:
         saved = save_calibration(result, args.dem_store)
         # inside: a Ctrl-C as the result printed was answered by the generic line, which
         # said the complete --out "may hold part of this run's files"
-        _print_result(args, result, own_notes, _saved_words(saved, args),
+        _print_result(args, result, own_notes, _saved_words(saved, args, unreported),
                       tally.specimens())
         interrupt.raise_if_interrupted()  # one swallowed on the way, or held by the move
     except BaseException as exc:  # noqa: BLE001 - an interrupt, or what one became in C code
@@ -162,7 +163,7 @@ def run(args: argparse.Namespace) -> int:
             raise
         # finished runs are each saved in their own transaction: counted from the store
         print(f"pidcore calibrate: interrupted; {tally.interrupted()}"
-              f"{_saved_words(saved, args) if fitted else ''}"
+              f"{_saved_words(saved, args, unreported) if fitted else ''}"
               f"{_out_words(args.out, written)}",
               file=sys.stderr)
         interrupt.mark_handled()
@@ -216,17 +217,22 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
             print(f"wrote {args.out}")
 
 
-def _saved_words(saved, args: argparse.Namespace) -> str:
+def _saved_words(saved, args: argparse.Namespace, unreported: str = "") -> str:
     """What became of the calibration in the store (:func:`pidcore.calibrate.persist.
     save_calibration`'s :class:`~pidcore.calibrate.persist.SavedCalibration`; None: not
-    saved)."""
+    saved), with the report of it to paste, or (``unreported``: :func:`_unreported`) why
+    none is printed."""
     store = args.dem_store
     if saved is None:
         return f"; the calibration was not saved in {store}"
     key, added = saved[0], saved[1]
     superseded = tuple(saved[2]) if len(saved) > 2 else ()
     if added:  # the key in the command: it still reads this one once the store holds more
-        then = _report_command(args, key)
+        then = _report_command(args, key) if not unreported else (
+            f"no report line to paste: {unreported}; a report of the measurements (their "
+            f"FILES, or a --store of their analyses) with "
+            f"{command_line('--calibration', store, '--calibration-key', key)} shows them "
+            "with its bands")
         words = f"; saved calibration {key} in {store} ({then})"
         if superseded:
             # "stored already" gave the earlier file: say that one is there, and why not it
@@ -246,6 +252,24 @@ def _report_command(args: argparse.Namespace, key: str) -> str:
     return command_line("pidcore", "report", *measured, "--dem-store", args.dem_store,
                         *specimen, "--calibration", args.dem_store, "--calibration-key", key,
                         "--out", "report_out")
+
+
+def _unreported(args: argparse.Namespace, tally, specimen) -> str:
+    """Why :func:`_report_command`'s report would show none of the calibrated load cases ("":
+    it shows them). Its rows are the measurements of --store, else the DEM runs of the
+    specimen (:func:`pidcore.dem.persist.runs_of_specimen`, as the report chooses them): a fit
+    of a DEM parameter runs only variants of the specimen, so the line printed for a --data
+    fit of one gave "(no load cases)"."""
+    from ..dem.persist import runs_of_specimen
+
+    if args.store is not None:
+        return ""
+    runs = tally.stored_runs()
+    if runs is not None and not runs_of_specimen(runs, specimen).empty:
+        return ""
+    return ("its DEM runs are variants of the specimen (the design's points), which a report "
+            "leaves out, and the --data table is no report input, so that report would have "
+            "no rows")
 
 
 def _store_points(points: list, specimen, store: Path, left_out: list[str]) -> list:
