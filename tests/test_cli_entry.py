@@ -179,6 +179,25 @@ def test_model_damper_out_with_a_tilde_writes_into_the_home_folder(capsys, tmp_p
     assert (home / "damper").is_dir() and list(work.iterdir()) == []
 
 
+class _Refused(Exception):
+    pass
+
+
+def _lenient_parsers():
+    """Every parser, with nothing required (an option is parsed alone, no FILE missing), its
+    usage errors raised as :class:`_Refused`."""
+    for parser in _all_parsers(build_parser()):
+        for action in parser._actions:
+            action.required = False
+        for group in parser._mutually_exclusive_groups:
+            group.required = False
+
+        def refuse(message: str, prog: str = parser.prog) -> None:
+            raise _Refused(f"{prog}: {message}")
+        parser.error = refuse
+        yield parser
+
+
 def _shortest_unique_prefix(option: str, others: list[str]) -> str | None:
     """The shortest prefix of a long ``option`` no other option of its parser starts with;
     None where there is none (it is itself a prefix of another: --fill of --fills)."""
@@ -193,17 +212,7 @@ def test_no_option_of_any_command_is_taken_from_a_prefix_of_its_name():
     # --mass-below-gauge (SDC 1.139 -> 1.238, saved) and `store remove KEY --with` as
     # --with-dependents (a calibration removed too)
     tried = 0
-    for parser in _all_parsers(build_parser()):
-        # nothing required, so a prefix not taken is left over rather than refused for a
-        # missing FILE; an error raises (an abbreviation taking a value it is not given)
-        for action in parser._actions:
-            action.required = False
-        for group in parser._mutually_exclusive_groups:
-            group.required = False
-
-        def refuse(message: str, prog: str = parser.prog) -> None:
-            raise AssertionError(f"{prog}: {message}")
-        parser.error = refuse
+    for parser in _lenient_parsers():
         options = [o for a in parser._actions for o in a.option_strings if o.startswith("--")]
         for option in options:
             prefix = _shortest_unique_prefix(option, options)
@@ -216,3 +225,27 @@ def test_no_option_of_any_command_is_taken_from_a_prefix_of_its_name():
             assert left == [prefix], (parser.prog, prefix, option)
             tried += 1
     assert tried > 100  # every command's options, nested commands included
+
+
+@pytest.mark.parametrize("number", ["-5e-5", "-1E+3", "-inf"])
+def test_a_negative_number_in_any_float_notation_is_a_value_of_every_option(number):
+    # argparse's pattern of a negative number knows no exponent: `--velocity-delay -5e-5`
+    # said "expected one argument" instead of the option's own range check
+    tried = 0
+    for parser in _lenient_parsers():
+        for action in parser._actions:
+            if not action.option_strings or action.nargs is not None:  # no value of one
+                continue
+            try:
+                parser.parse_known_args([action.option_strings[0], number])
+            except _Refused as refused:  # the option's own check (a type, choices) is fine
+                assert "expected one argument" not in str(refused), refused
+            tried += 1
+    assert tried > 100
+
+
+def test_a_negative_delay_in_scientific_notation_meets_the_delays_own_check(capsys):
+    assert console_main(["analyze", "x.csv", "--no-store", "--velocity-delay", "-5e-5"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("pidcore analyze: error: --velocity-delay: -5e-05 s, expected a "
+                          "delay >= 0 s"), err

@@ -21,6 +21,20 @@ _COMMAND_MODULES = ("analyze", "dem", "specimen", "bench", "report", "model", "a
                     "samples", "calibrate", "store")
 
 
+class _NegativeNumber:
+    """argparse's ``_negative_number_matcher``: whether a word is a negative number, as
+    :func:`float` reads it (``-5e-5``, ``-.5``, ``-inf``)."""
+
+    def match(self, word: str) -> bool:
+        if not word.startswith("-"):
+            return False
+        try:
+            float(word)
+        except ValueError:
+            return False
+        return True
+
+
 class _OneLineParser(argparse.ArgumentParser):
     """Usage errors as one line naming the sub-command (``pidcore analyze: error: ...``), exit 2;
     the usage stays one ``--help`` away. Sub-parsers inherit the class."""
@@ -31,6 +45,10 @@ class _OneLineParser(argparse.ArgumentParser):
         # silently change what an old abbreviation means
         kwargs["allow_abbrev"] = False
         super().__init__(*args, **kwargs)
+        # argparse takes "-5e-5" for an option (its pattern knows no exponent) and says
+        # "expected one argument"; a value in any float notation is a value, so that the
+        # option's own check speaks ("expected a delay >= 0 s")
+        self._negative_number_matcher = _NegativeNumber()
 
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
