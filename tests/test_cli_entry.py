@@ -249,3 +249,25 @@ def test_a_negative_delay_in_scientific_notation_meets_the_delays_own_check(caps
     err = capsys.readouterr().err
     assert err.startswith("pidcore analyze: error: --velocity-delay: -5e-05 s, expected a "
                           "delay >= 0 s"), err
+
+
+def test_an_empty_item_of_any_comma_list_option_is_refused_naming_the_option():
+    # `dem sweep --frequencies 50,,200` ran 2 load cases without a word (report --format
+    # refused its empty item, model damper and calibrate --fit dropped theirs too)
+    lists = []
+    for parser in _lenient_parsers():
+        for action in parser._actions:
+            if not action.option_strings or action.nargs is not None or not (
+                    "," in str(action.metavar) or action.metavar == "LIST"
+                    or "comma" in (action.help or "")):
+                continue
+            option = action.option_strings[0]
+            for given in ("50,,200", "csv,", ""):
+                with pytest.raises(_Refused, match=f"argument {option}: expected comma-"
+                                                   "separated values, none of them empty"):
+                    parser.parse_known_args([option, given])
+            lists.append(f"{parser.prog.removeprefix('pidcore ')} {option}")
+    assert sorted(lists) == [
+        "calibrate --fit", "dem sweep --accelerations", "dem sweep --fills",
+        "dem sweep --frequencies", "model damper --accelerations", "model damper --fills",
+        "model damper --format", "model damper --frequencies", "report --format"]

@@ -54,6 +54,17 @@ def path_argument(text: str) -> Path:
     return Path(expanded)
 
 
+def comma_list(text: str) -> list[str]:
+    """argparse type of every comma-separated list option (``--fills 40,60``, ``--format
+    csv,md``): its items, stripped, an empty one refused: ``--frequencies 50,,200`` ran 2
+    load cases without a word, where a value meant was lost between the commas."""
+    items = [item.strip() for item in text.split(",")]
+    if not all(items):
+        raise argparse.ArgumentTypeError(
+            f"expected comma-separated values, none of them empty, got {text!r}")
+    return items
+
+
 def positive_int(text: str) -> int:
     """argparse type: a whole number >= 1 (a count of repetitions, samples or processes)."""
     return _whole_number(text, 1)

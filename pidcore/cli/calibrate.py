@@ -9,6 +9,7 @@ from pathlib import Path
 from .. import defaults, interrupt
 from ._options import (
     check_out_folder,
+    comma_list,
     command_line,
     non_negative_int,
     path_argument,
@@ -48,7 +49,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                              "a note names the ones left out")
     p.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
                    help="specimen file to start from (default: the paper's coupon)")
-    p.add_argument("--fit", metavar="NAME,...", default=",".join(DEFAULT_FIT),
+    p.add_argument("--fit", metavar="NAME,...", type=comma_list, default=",".join(DEFAULT_FIT),
                    help=f"parameters to fit (default %(default)s); from: {names}")
     p.add_argument("--prior", metavar="NAME=LOW:HIGH", action="append", default=[],
                    help="change a prior: NAME=LOW:HIGH (uniform) or "

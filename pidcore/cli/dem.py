@@ -22,6 +22,7 @@ from ..errors import ParameterError, PidcoreError, apart
 from ._options import (
     add_json_option,
     add_store_option,
+    comma_list,
     non_negative_int,
     path_argument,
     positive_int,
@@ -151,7 +152,7 @@ def _register_sweep(sub: argparse._SubParsersAction) -> None:
     for flag, what in (("--frequencies", "drive frequencies, Hz"),
                        ("--accelerations", "acceleration amplitudes, g"),
                        ("--fills", "fills (packing ratios), %%")):
-        p.add_argument(flag, metavar="X,X", default=None,
+        p.add_argument(flag, metavar="X,X", type=comma_list, default=None,
                        help=f"{what}, comma-separated, in place of the grid's (every "
                             "combination is run, each value once, in Table 3's order: "
                             "ascending, whatever the order given)"
@@ -236,7 +237,8 @@ def sweep(args: argparse.Namespace) -> int:
     # before any note or file is read: its one line alone
     check_workers_or_scheduler(args.workers, args.scheduler)
     axes = grid_axes(args.grid)
-    values = [axes[axis] if given is None else parse_values(given, name=flag)
+    values = [axes[axis] if given is None else
+              [value for item in given for value in parse_values(item, name=flag)]
               for axis, given, flag in (("frequency_hz", args.frequencies, "--frequencies"),
                                         ("acceleration_g", args.accelerations,
                                          "--accelerations"),

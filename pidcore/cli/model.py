@@ -19,17 +19,21 @@ from ..atomic_files import refused_unless_written
 from ..constants import PARTICLE_MATERIALS, VIBRATED_MASS_CONVENTIONS
 from ..errors import ParameterError, as_given
 from ..out_folder import check_replaceable, write_folder_whole
-from ._options import add_store_option, check_out_folder, command_line, path_argument
+from ._options import (
+    add_store_option,
+    check_out_folder,
+    comma_list,
+    command_line,
+    path_argument,
+)
 
 
 def _float_list(text: str) -> list[float]:
     try:
-        values = [float(v) for v in text.split(",") if v.strip()]
+        values = [float(v) for v in comma_list(text)]
     except ValueError as exc:
         raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") \
             from exc
-    if not values:
-        raise argparse.ArgumentTypeError("expected at least one number")
     if not all(math.isfinite(v) for v in values):
         raise argparse.ArgumentTypeError(f"expected finite numbers, got {text!r}")
     return values
@@ -46,9 +50,9 @@ def _positive_float(text: str) -> float:
 
 
 def _formats(text: str) -> list[str]:
-    formats = [v.strip().lower() for v in text.split(",") if v.strip()]
+    formats = [v.lower() for v in comma_list(text)]
     bad = sorted(set(formats) - {"csv", "json"})
-    if bad or not formats:
+    if bad:
         raise argparse.ArgumentTypeError(f"unknown format(s) {bad or text!r}; expected csv,json")
     return formats
 

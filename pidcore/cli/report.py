@@ -31,6 +31,7 @@ from ._options import (
     add_measurement_options,
     add_store_option,
     analysis_options,
+    comma_list,
     given_options,
     path_argument,
     progress_wanted,
@@ -73,7 +74,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         "repeat it to join the runs of several stores (the first holding a "
                         "run gives it), as the app joins its store's runs with the reference "
                         "runs: --dem-store APP.h5 --dem-store REFERENCE.h5")
-    p.add_argument("--format", metavar="FMT", default="all",
+    p.add_argument("--format", metavar="FMT", type=comma_list, default="all",
                    help="all or a comma-separated list of csv, md, html, tex, pdf (default "
                         "all); the figures (PNG and SVG, figures/) are written with any")
     add_load_case_options(p, what="FILE")
