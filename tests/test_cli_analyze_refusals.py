@@ -482,3 +482,19 @@ def test_a_store_name_too_long_for_its_working_copy_is_refused_before_any_analys
     assert f"{store.name}: the store's name is 238 bytes, too long for the working copy" in err
     assert "at most 233 bytes" in err
     assert os.listdir(tmp_path) == ["rec.csv"]
+
+
+def test_a_pipe_is_refused_as_no_regular_file_not_as_a_file_not_found(record_and_store,
+                                                                       capsys):
+    # `analyze <(cat rec.csv)`: the shell passes /dev/fd/N, a pipe; its first bytes were read
+    # to detect the format and it was then called "file not found"
+    path, store = record_and_store
+    read_end, write_end = os.pipe()
+    try:
+        os.write(write_end, path.read_bytes()[:4096])  # within a pipe's buffer: no reader needed
+        os.close(write_end)
+        err = _refused([f"/dev/fd/{read_end}"], store, capsys)
+    finally:
+        os.close(read_end)
+    assert err == (f"pidcore analyze: error: /dev/fd/{read_end}: not a regular file (a pipe?); "
+                   "give a file\n")

@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import os
 import re
+import stat
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import replace
@@ -95,6 +96,7 @@ def detect_file_format(path: str | os.PathLike[str]) -> str:
     # an int is a file descriptor to open(): read_measurement(0) read stdin
     instance_of("path", path, (str, os.PathLike), hint="a file name")
     where = str(path)
+    _refuse_unless_a_file(path)
     try:
         with open(path, "rb") as fh:
             head = fh.read(1024)
@@ -118,6 +120,19 @@ def detect_file_format(path: str | os.PathLike[str]) -> str:
         return "csv"
     raise InputFileError(f"{where}: unknown file format; expected UFF (.uff/.unv), CSV/TXT, "
                          "MATLAB (.mat) or pidcore HDF5 (.h5)")
+
+
+def _refuse_unless_a_file(path: str | os.PathLike[str]) -> None:
+    """Refuse a path that exists but holds no file to read twice: a named pipe or process
+    substitution (``analyze <(cat f.csv)``) was called "file not found" once its first bytes
+    were read to detect the format, and opening a pipe with no writer waits for ever. A
+    missing path or a folder is left to what opening it says."""
+    try:
+        mode = os.stat(path).st_mode
+    except OSError:
+        return
+    if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+        raise InputFileError(f"{path}: not a regular file (a pipe?); give a file")
 
 
 def display_path(path: str | os.PathLike[str]) -> str:
@@ -179,6 +194,7 @@ def read_measurements(path: str | os.PathLike[str], *, sample_rate_hz: float | N
     """
     instance_of("path", path, (str, os.PathLike), hint="a file name")
     _check_format(file_format)
+    _refuse_unless_a_file(path)
     fmt = file_format or detect_file_format(path)
     if fmt == "hdf5":
         with _one_line_errors(path, fmt):
@@ -225,6 +241,7 @@ def read_measurement(path: str | os.PathLike[str], *, sample_rate_hz: float | No
     """
     instance_of("path", path, (str, os.PathLike), hint="a file name")
     _check_format(file_format)
+    _refuse_unless_a_file(path)
     fmt = file_format or detect_file_format(path)
     if not Path(path).is_file():
         raise InputFileError(f"{path}: file not found")
