@@ -271,3 +271,49 @@ def test_an_empty_item_of_any_comma_list_option_is_refused_naming_the_option():
         "calibrate --fit", "dem sweep --accelerations", "dem sweep --fills",
         "dem sweep --frequencies", "model damper --accelerations", "model damper --fills",
         "model damper --format", "model damper --frequencies", "report --format"]
+
+
+def _a_value(action: argparse.Action) -> str:
+    """A word the option takes alone (its first choice, else one its type reads)."""
+    if action.choices:
+        return str(next(iter(action.choices)))
+    for word in ("1", "a", "csv"):
+        try:
+            (action.type or str)(word)
+        except (argparse.ArgumentTypeError, TypeError, ValueError):
+            continue
+        return word
+    raise AssertionError(f"no value found for {action.option_strings}")
+
+
+def test_every_single_valued_option_given_twice_is_refused_naming_both_values():
+    # `analyze F --fill 70 --fill 30` saved 30 % and `--store a.h5 --store b.h5` wrote to
+    # b.h5 without a word: the last one won. Options meant to be repeated (append: --invert,
+    # --prior, report --dem-store) and flags (store_true) are left as they were
+    repeatable = (argparse._AppendAction, argparse._CountAction, argparse._HelpAction,
+                  argparse._VersionAction, argparse._SubParsersAction)
+    tried = []
+    for parser in _lenient_parsers():
+        for action in parser._actions:
+            if not action.option_strings or action.nargs == 0 or isinstance(action,
+                                                                            repeatable):
+                continue
+            option, word = action.option_strings[0], _a_value(action)
+            words = [word] * (action.nargs if isinstance(action.nargs, int) else 1)
+            with pytest.raises(_Refused, match=re.escape(
+                    f"argument {'/'.join(action.option_strings)}: given twice "
+                    f"({' '.join(words)}, {' '.join(words)}); give it once")):
+                parser.parse_known_args([option, *words, option, *words])
+            tried.append(f"{parser.prog.removeprefix('pidcore ')} {option}")
+    assert {"analyze --fill", "analyze --store", "dem sweep --fills"} <= set(tried)
+    assert len(tried) > 100
+
+
+def test_options_meant_to_be_repeated_still_take_every_value(tmp_path):
+    parser = build_parser()
+    args = parser.parse_args(["analyze", "f.csv", "--invert", "a", "--invert", "b",
+                              "--allow-clipped", "--allow-clipped"])
+    assert args.invert == ["a", "b"] and args.allow_clipped
+    args = parser.parse_args(["report", "--out", "r", "--dem-store", "a.h5", "--dem-store",
+                              "b.h5"])
+    assert args.dem_store == [Path("a.h5"), Path("b.h5")]

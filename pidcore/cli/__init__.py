@@ -35,6 +35,22 @@ class _NegativeNumber:
         return True
 
 
+class _GivenOnce(argparse._StoreAction):
+    """The default action of every option: a single value, refused when given a second time.
+    ``analyze --fill 70 --fill 30`` saved 30 % and ``--store a.h5 --store b.h5`` wrote to
+    b.h5 without a word, where one of the two was a slip; options meant to be repeated say so
+    with ``action="append"`` (``--invert``, ``--prior``) and flags may repeat harmlessly."""
+
+    def __call__(self, parser, namespace, values, option_string=None) -> None:
+        given = parser._given_once  # this parse's words per option (_OneLineParser)
+        words = " ".join(parser._last_words)
+        if self.dest in given:
+            raise argparse.ArgumentError(
+                self, f"given twice ({given[self.dest]}, {words}); give it once")
+        given[self.dest] = words
+        super().__call__(parser, namespace, values, option_string)
+
+
 class _OneLineParser(argparse.ArgumentParser):
     """Usage errors as one line naming the sub-command (``pidcore analyze: error: ...``), exit 2;
     the usage stays one ``--help`` away. Sub-parsers inherit the class."""
@@ -49,6 +65,19 @@ class _OneLineParser(argparse.ArgumentParser):
         # "expected one argument"; a value in any float notation is a value, so that the
         # option's own check speaks ("expected a delay >= 0 s")
         self._negative_number_matcher = _NegativeNumber()
+        self.register("action", None, _GivenOnce)  # add_argument without an action
+        self._given_once: dict[str, str] = {}
+        self._last_words: list[str] = []
+
+    def parse_known_args(self, args=None, namespace=None):
+        self._given_once = {}  # each parse counts its own (a sub-command's parser: its own)
+        return super().parse_known_args(args, namespace)
+
+    def _get_values(self, action, arg_strings):
+        # the words as typed, for _GivenOnce's message: its values are converted (70.0 for
+        # "70", a Path)
+        self._last_words = list(arg_strings)
+        return super()._get_values(action, arg_strings)
 
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
