@@ -12,6 +12,26 @@ from __future__ import annotations
 
 import sys
 
+#: Every sub-command and its actions (none for one without): read here, before any of
+#: :mod:`pidcore.cli` is loaded, to name the command a Ctrl-C interrupted as the user typed
+#: it (``pidcore dem sweep``, not ``pidcore dem``); :mod:`pidcore.cli` registers these.
+COMMANDS: dict[str, tuple[str, ...]] = {
+    "analyze": (), "dem": ("run", "sweep"), "specimen": ("check", "kept"),
+    "bench": ("signal", "read", "store", "dem"), "report": (), "model": ("damper", "figures"),
+    "app": (), "samples": ("make",), "calibrate": (), "store": ("list", "verify", "remove"),
+}
+
+
+def command_name(words: list[str]) -> str:
+    """The sub-command a command line (``words``, after the program's name) names, for its
+    messages: its first word that is no option, with the action after it where it is one of
+    the command's (``dem sweep``); ``COMMAND`` where it names none."""
+    for i, word in enumerate(words):
+        if not word.startswith("-"):
+            action = words[i + 1] if i + 1 < len(words) else None
+            return f"{word} {action}" if action in COMMANDS.get(word, ()) else word
+    return "COMMAND"
+
 
 def main() -> int:
     """Run the command line (:func:`pidcore.cli.console_main`); a Ctrl-C while it loads
@@ -24,7 +44,7 @@ def main() -> int:
         # the command is over: a second Ctrl-C during the shutdown must not turn the 130
         # into a death by SIGINT
         signal.signal(signal.SIGINT, signal.SIG_IGN)
-        command = next((word for word in sys.argv[1:] if not word.startswith("-")), "COMMAND")
-        print(f"pidcore {command}: interrupted; nothing was done", file=sys.stderr)
+        print(f"pidcore {command_name(sys.argv[1:])}: interrupted; nothing was done",
+              file=sys.stderr)
         return 130
     return console_main()

@@ -39,6 +39,7 @@ from .atomic_files import (
     restore_previous_folder,
 )
 from .errors import ParameterError
+from .interrupt import untouched
 
 #: The record a run writes into its output folder: ``{"written_by": "pidcore <command>",
 #: "files": {path in the folder (``/``-separated): SHA-256 of its bytes}}``.
@@ -201,3 +202,33 @@ def write_folder_whole(out: str | os.PathLike[str], command: str,
         raise
     interrupt.raise_if_interrupted()
     return [out / p.relative_to(work) for p in paths]
+
+
+def folder_identity(folder: str | os.PathLike[str]) -> tuple[int, int] | None:
+    """``(device, inode)`` of a folder (a link's: the one it points to), None if there is
+    none: :func:`write_folder_whole` puts a new folder in place, so a caller that took this
+    before can tell after a Ctrl-C whether the outputs were written (identity changed) or the
+    folder is as it was."""
+    try:
+        st = os.stat(folder)
+    except OSError:
+        return None
+    return st.st_dev, st.st_ino
+
+
+def identity_before(out: str | os.PathLike[str], command: str) -> tuple[int, int] | None:
+    """:func:`folder_identity` of ``out`` before a run of ``pidcore command`` writes it, an
+    earlier folder a killed swap hid put back first (:func:`restore_previous`, which the write
+    does anyway): else the restored folder would pass for this run's after a Ctrl-C."""
+    restore_previous(out, command)
+    return folder_identity(out)
+
+
+def interrupted_outputs(out: str | os.PathLike[str], before: tuple[int, int] | None) -> str:
+    """What a Ctrl-C left of an output folder :func:`write_folder_whole` writes, from its
+    :func:`identity_before` the run: the run's whole set of files, or the folder as it was
+    (never part of them: it is replaced in one step)."""
+    if folder_identity(out) != before:
+        return f"{out} holds this run's whole set of files (written before the interrupt)"
+    kept = f"{out} is as it was" if Path(out).exists() else untouched(out)
+    return f"{kept} (its files are replaced whole or not at all)"

@@ -387,7 +387,8 @@ _INTERRUPT_AS_THE_CLI_LOADS = (
 )
 
 
-def test_ctrl_c_while_the_cli_loads_exits_130_with_one_line(tmp_path):
+def test_ctrl_c_while_the_cli_loads_exits_130_with_one_line_naming_the_command_and_action(
+        tmp_path):
     # Found by sending SIGINT to `python -m pidcore dem sweep` at random moments: one at
     # 0.05 s landed while pidcore.cli imported its modules, before main installs the handler,
     # and ended in Python's traceback and a death by SIGINT (status -2). The interrupt is
@@ -400,8 +401,88 @@ def test_ctrl_c_while_the_cli_loads_exits_130_with_one_line(tmp_path):
     done = subprocess.run([sys.executable, "-c", probe, str(store)], capture_output=True,
                           text=True, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=120)
     assert done.returncode == 130, done.stderr
-    assert done.stderr.splitlines() == ["pidcore dem: interrupted; nothing was done"]
+    # the whole sub-command, as typed: "pidcore dem" named a command of two actions
+    assert done.stderr.splitlines() == ["pidcore dem sweep: interrupted; nothing was done"]
     assert not store.exists()
+
+
+@pytest.mark.parametrize(("words", "named"), [
+    (["dem", "sweep", "--store", "s.h5"], "dem sweep"), (["model", "figures"], "model figures"),
+    (["analyze", "run.csv"], "analyze"), (["dem", "--help"], "dem"),
+    (["store", "bogus"], "store"), (["--version"], "COMMAND"), (["typo", "x"], "typo")])
+def test_an_interrupt_before_the_parser_names_the_command_with_its_action(words, named):
+    from pidcore.console import command_name
+
+    assert command_name(words) == named
+
+
+def test_every_command_and_action_the_cli_registers_is_known_before_it_loads():
+    import argparse
+
+    from pidcore.cli import build_parser
+    from pidcore.console import COMMANDS
+
+    def actions(parser):
+        return next((tuple(a.choices) for a in parser._actions
+                     if isinstance(a, argparse._SubParsersAction)), ())
+
+    commands = {name: actions(sub) for name, sub in
+                next(a for a in build_parser()._actions
+                     if isinstance(a, argparse._SubParsersAction)).choices.items()}
+    assert commands == COMMANDS
+
+
+def _quick_model_figures(monkeypatch, *, interrupt_at: str | None):
+    """``model figures`` with its figures stubbed (a file each, no drawing), a Ctrl-C at
+    ``interrupt_at``: "draw" (before the folder is swapped) or "swap" (right after)."""
+    import pidcore.out_folder as out_folder
+    import pidcore.report.figures as figures
+
+    def save(fig, folder, name):
+        if interrupt_at == "draw":
+            signal.raise_signal(signal.SIGINT)
+        path = Path(folder) / f"{name}.png"
+        path.write_text("figure")
+        return [path]
+
+    monkeypatch.setattr(figures, "plot_sdc_vs_acceleration", lambda *a, **k: None)
+    monkeypatch.setattr(figures, "plot_sdc_vs_frequency", lambda *a, **k: None)
+    monkeypatch.setattr(figures, "save_figure", save)
+    real_replace = out_folder.replace_folder
+
+    def replace_then_sigint(new, target):
+        real_replace(new, target)
+        signal.raise_signal(signal.SIGINT)
+
+    if interrupt_at == "swap":
+        monkeypatch.setattr(out_folder, "replace_folder", replace_then_sigint)
+
+
+def test_an_interrupted_model_figures_says_its_out_folder_is_whole_not_part(
+        tmp_path, capsys, monkeypatch):
+    # "(mf may hold part of this run's files)": the folder is replaced whole
+    # (pidcore.out_folder), so it holds the earlier set or the new one, never part
+    from pidcore.cli import main
+
+    mf = tmp_path / "mf"
+    said = "pidcore model figures: interrupted; no store write was left half-done; "
+    _quick_model_figures(monkeypatch, interrupt_at="draw")
+    assert main(["model", "figures", "--out", str(mf)]) == 130
+    assert capsys.readouterr().err == (f"{said}{mf} not created (its files are replaced whole "
+                                       "or not at all)\n")
+    assert not mf.exists()
+    _quick_model_figures(monkeypatch, interrupt_at=None)
+    assert main(["model", "figures", "--out", str(mf)]) == 0
+    before = sorted(p.name for p in mf.iterdir())
+    _quick_model_figures(monkeypatch, interrupt_at="draw")
+    assert main(["model", "figures", "--out", str(mf)]) == 130
+    assert capsys.readouterr().err.endswith(
+        f"{said}{mf} is as it was (its files are replaced whole or not at all)\n")
+    assert sorted(p.name for p in mf.iterdir()) == before
+    _quick_model_figures(monkeypatch, interrupt_at="swap")
+    assert main(["model", "figures", "--out", str(mf)]) == 130
+    assert capsys.readouterr().err == (
+        f"{said}{mf} holds this run's whole set of files (written before the interrupt)\n")
 
 
 def _installed_entry() -> tuple[str, str]:
@@ -435,7 +516,8 @@ def test_ctrl_c_while_the_installed_pidcore_script_loads_exits_130_with_one_line
     done = subprocess.run([sys.executable, "-c", probe, str(store)], capture_output=True,
                           text=True, env={**os.environ, "PYTHONPATH": str(ROOT)}, timeout=120)
     assert done.returncode == 130, done.stderr
-    assert done.stderr.splitlines() == ["pidcore dem: interrupted; nothing was done"]
+    # the whole sub-command, as typed: "pidcore dem" named a command of two actions
+    assert done.stderr.splitlines() == ["pidcore dem sweep: interrupted; nothing was done"]
     assert not store.exists()
     # the guard only helps if the entry's module loads nothing of pidcore's before it
     loaded = subprocess.run(

@@ -14,11 +14,11 @@ import sys
 from collections.abc import Callable
 
 from .. import interrupt
+from ..console import COMMANDS, command_name
 from ..errors import PidcoreError
 
 #: Sub-command modules, each exposing ``register(subparsers) -> None``.
-_COMMAND_MODULES = ("analyze", "dem", "specimen", "bench", "report", "model", "app",
-                    "samples", "calibrate", "store")
+_COMMAND_MODULES = tuple(COMMANDS)
 
 
 class _NegativeNumber:
@@ -161,7 +161,7 @@ def _main(argv: list[str] | None, *, then_ignore: bool = False) -> tuple[int, bo
         rc = _run(argv)
         return rc, interrupt.interrupted()
     except KeyboardInterrupt:  # before _run's try, or after it returned
-        return _interrupted(_command_word(argv), None), True
+        return _interrupted(command_name(sys.argv[1:] if argv is None else argv), None), True
     finally:
         with interrupt.deferred():  # a Ctrl-C here is recorded, not raised: the run is over
             if streams is not None:
@@ -173,20 +173,14 @@ def _main(argv: list[str] | None, *, then_ignore: bool = False) -> tuple[int, bo
         interrupt.reset()  # an in-process caller (app, tests) may commit again afterwards
 
 
-def _command_word(argv: list[str] | None) -> str:
-    """The sub-command a command line names (its first word that is no option), for its
-    messages; ``COMMAND`` where it names none."""
-    words = sys.argv[1:] if argv is None else argv
-    return next((w for w in words if not w.startswith("-")), "COMMAND")
-
-
 def _run(argv: list[str] | None) -> int:
     words = sys.argv[1:] if argv is None else argv
-    command = _command_word(words)
+    command = command_name(words)  # until the parser names it
     started = False
     args: argparse.Namespace | None = None
+    out_before: tuple[int, int] | None = None
     try:
-        parser = build_parser(command)
+        parser = build_parser(command.split(" ", 1)[0])
         args, unknown = parser.parse_known_args(argv)
         command = _command_name(args)
         if unknown:  # reported by the top parser, which would not name the sub-command
@@ -194,6 +188,7 @@ def _run(argv: list[str] | None) -> int:
                            f"{' '.join(unknown)} (see pidcore {command} --help)\n")
         from ..specimen import hearing_read_notes  # before the start: nothing done yet
 
+        out_before = _out_before(args)
         started = True
         # what reading a --specimen file did first (a killed calibration's moves into its
         # folder finished) said here, for every command that takes one, as their notes are
@@ -205,7 +200,7 @@ def _run(argv: list[str] | None) -> int:
     except PidcoreError as exc:
         if interrupt.interrupted():  # an interrupt swallowed by a library (pyuff's bare
             # ``except:``) left data out and surfaced as a refusal: it is the interruption
-            return _interrupted(command, args if started else None)
+            return _interrupted(command, args if started else None, out_before)
         print(f"pidcore {command}: error: {_in_flags(exc, command, words)}", file=sys.stderr)
         return 2
     except BrokenPipeError:  # the reader of stdout (| head) stopped: end quietly
@@ -219,15 +214,28 @@ def _run(argv: list[str] | None) -> int:
             raise
         # commands that count what they saved say so themselves (analyze, dem, calibrate);
         # here only what holds for every command: a store write is whole or absent, never
-        # half-done, and an output folder may hold part of the files
-        return _interrupted(command, args if started else None)
+        # half-done, and an output folder holds part of the files or, replaced whole, one set
+        return _interrupted(command, args if started else None, out_before)
 
 
-def _interrupted(command: str, args: argparse.Namespace | None) -> int:
+def _out_before(args: argparse.Namespace) -> tuple[int, int] | None:
+    """The identity of a command's ``--out`` before it runs, where the command replaces it
+    whole (``out_written_whole_by``: its name in :mod:`pidcore.out_folder`'s records)."""
+    command = getattr(args, "out_written_whole_by", None)
+    if command is None:
+        return None
+    from ..out_folder import identity_before
+
+    return identity_before(args.out, command)
+
+
+def _interrupted(command: str, args: argparse.Namespace | None,
+                 out_before: tuple[int, int] | None = None) -> int:
     """Say on stderr that ``pidcore COMMAND`` was interrupted and what it may have left
-    (``args``: the command's, None before it started: nothing was done); returns the exit
-    status of an interruption, marked handled."""
-    said = _what_an_interrupt_left(args) if args is not None else "nothing was done"
+    (``args``: the command's, None before it started: nothing was done; ``out_before``: its
+    :func:`_out_before`); returns the exit status of an interruption, marked handled."""
+    said = _what_an_interrupt_left(args, out_before) if args is not None else \
+        "nothing was done"
     print(f"pidcore {command}: interrupted; {said}", file=sys.stderr)
     interrupt.mark_handled()
     return interrupt.exit_status()
@@ -261,21 +269,30 @@ def _in_flags(exc: PidcoreError, command: str, words: list[str]) -> str:
         _in_command_words(str(exc), command, words)
 
 
-def _what_an_interrupt_left(args: argparse.Namespace) -> str:
+def _what_an_interrupt_left(args: argparse.Namespace,
+                            out_before: tuple[int, int] | None) -> str:
     """What an interrupted command may have left, from the options it was given: a store
     (``--store``/``--dem-store``; none with ``--no-store``) whose writes are whole or absent,
-    an ``--out`` folder that may hold part of the files. Only what the command has: an
-    "output folder" said of ``analyze --no-store`` named something it does not have."""
+    an ``--out`` folder that may hold part of the files, or where the command replaces it
+    whole (``model figures``: "mf may hold part" was untrue) the folder as it was or the
+    run's whole set. Only what the command has: an "output folder" said of ``analyze
+    --no-store`` named something it does not have."""
     stores = [] if getattr(args, "no_store", False) else \
         [s for s in (getattr(args, "store", None), getattr(args, "dem_store", None)) if s]
     out = getattr(args, "out", None)
-    if stores and out is not None:
-        return f"no store write was left half-done ({out} may hold part of this run's files)"
+    if out is None:
+        outputs = None
+    elif getattr(args, "out_written_whole_by", None) is not None:
+        from ..out_folder import interrupted_outputs
+
+        outputs = interrupted_outputs(out, out_before)
+    else:
+        outputs = f"{out} may hold part of this run's files"
+    if stores and outputs is not None:
+        return f"no store write was left half-done; {outputs}"
     if stores:
         return "no store write was left half-done"
-    if out is not None:
-        return f"{out} may hold part of this run's files"
-    return "nothing was saved"
+    return outputs if outputs is not None else "nothing was saved"
 
 
 def _command_name(args: argparse.Namespace) -> str:

@@ -130,14 +130,15 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     d.add_argument("--panel-treated-fraction", metavar="F", type=_positive_float, default=None,
                    help="with --panel-areal-mass: share of the panel's area filled, in (0, 1] "
                         "(default 1)")
-    d.set_defaults(func=run_damper)
+    # --out is replaced whole (pidcore.out_folder): an interrupt's line says which set it holds
+    d.set_defaults(func=run_damper, out_written_whole_by="model damper")
 
     f = sub.add_parser("figures", help="SDC figures (paper Figs. 8-14), PNG and SVG")
     _add_model_source(f)
     f.add_argument("--specimen", metavar="FILE", type=path_argument, default=None,
                    help="with --table store: draw the store's runs of this specimen file (by "
                         "its sha256), the other specimens' left out")
-    f.set_defaults(func=run_figures)
+    f.set_defaults(func=run_figures, out_written_whole_by="model figures")
 
 
 def build_model(args: argparse.Namespace):

@@ -10,10 +10,10 @@ import sys
 
 from .. import interrupt
 from ..interrupt import untouched
+from ..out_folder import folder_identity
 from ..report.fonts import figure_fonts, missing_glyphs_note
 from ..report.render import (
     display_rows,
-    folder_identity,
     restore_previous_report,
     restored_report_note,
 )

@@ -17,7 +17,6 @@ import csv
 import hashlib
 import html
 import math
-import os
 import re
 import textwrap
 from collections.abc import Callable, Iterable, Mapping, Sequence
@@ -864,14 +863,3 @@ def write_report(table: pd.DataFrame, figures: Mapping[str, object], provenance:
         if bar is not None:
             bar.close()
     return dict(zip(written, paths, strict=True))
-
-
-def folder_identity(folder: str | Path) -> tuple[int, int] | None:
-    """``(device, inode)`` of a folder, None if there is none: :func:`write_report` puts a
-    new folder in place, so a caller that took this before can tell after a Ctrl-C whether the
-    report was written (identity changed) or the folder is as it was."""
-    try:
-        st = os.stat(folder)
-    except OSError:
-        return None
-    return st.st_dev, st.st_ino
