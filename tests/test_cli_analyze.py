@@ -818,3 +818,19 @@ def test_a_two_word_material_in_a_file_name_is_named_whole(tmp_path, capsys):
     spec.write_text(STEEL_SPECIMEN.replace('material = "steel"', 'material = "tungsten_carbide"'))
     doc = run_json([str(path), "--specimen", str(spec), "--no-store"], capsys)
     assert doc["records"][0]["load_case"].endswith("_fill40pct_tungsten_carbide_z")
+
+
+def test_json_names_a_non_utf8_file_with_the_escapes_store_list_now_uses_too(tmp_path, capsys):
+    # analyze --json printed a file's name as "ex2_\\xff..." and store list a store's as a
+    # lone surrogate "st_\udcff.h5": every name in a --json document now takes the first
+    import os
+
+    path = export(tmp_path / os.fsdecode(b"ex2_\xff_fill50.csv"), fmt="csv")
+    store = tmp_path / os.fsdecode(b"st_\xff.h5")
+    assert main(["analyze", str(path), "--store", str(store), "--json"]) == 0
+    text = capsys.readouterr().out
+    document = json.loads(text)
+    json.dumps(document, ensure_ascii=False).encode("utf-8")  # no lone surrogate anywhere
+    (record,) = document["records"]
+    assert record["source"].endswith("ex2_\\xff_fill50.csv")
+    assert "\\udc" not in text

@@ -172,3 +172,24 @@ def test_the_specimen_kept_command_a_removal_points_to_names_the_store_as_one_wo
     (line,) = re.findall(r"`(pidcore specimen kept [^`]*)` removes them", said)
     assert shlex.split(line) == ["pidcore", "specimen", "kept", "--remove", "--store",
                                  str(store)]
+
+
+def _strict_json(text: str):
+    """``text`` read as JSON a strict reader takes: no lone surrogate in any string (Python's
+    reader takes ``"\\udcff"``, a strict one refuses it), so it encodes to UTF-8 as it is."""
+    document = json.loads(text)
+    json.dumps(document, ensure_ascii=False).encode("utf-8")  # raises on a lone surrogate
+    return document
+
+
+def test_list_and_verify_json_name_a_non_utf8_store_with_escapes_as_analyze_does(
+        records_store_copy, capsys):
+    # `store list --json` on st_\xff.h5 printed "st_\udcff.h5", a lone surrogate strict JSON
+    # readers refuse, where analyze --json printed its file as "ex2_\\xff...": one rule
+    path, _ = records_store_copy
+    store = path.with_name(os.fsdecode(b"st_\xff.h5"))
+    os.replace(path, store)
+    for action in ("list", "verify"):
+        assert main(["store", action, "--store", str(store), "--json"]) == 0
+        listed = _strict_json(capsys.readouterr().out)
+        assert listed["store"] == f"{store.parent}/st_\\xff.h5", action

@@ -150,6 +150,33 @@ def scheduler_address(text: str) -> str:
     return text.strip()
 
 
+def displayed_names(document):
+    """A ``--json`` document with every file name in it as :func:`pidcore.io.display_path`
+    shows it: the bytes of a name that are not UTF-8 (``os.fsdecode``'s surrogates, a store
+    ``st_\\xff.h5``) as ``\\xNN``, as analyze stores a file's name. ``store list`` printed
+    ``"st_\\udcff.h5"``, a lone surrogate strict JSON readers refuse, where analyze printed
+    ``"ex2_\\\\xff..."``: one rule for every name, wherever in the document it lies (a path,
+    a note naming one, a key)."""
+    from ..io import display_path
+
+    if isinstance(document, dict):
+        return {displayed_names(k): displayed_names(v) for k, v in document.items()}
+    if isinstance(document, (list, tuple)):
+        return [displayed_names(v) for v in document]
+    if isinstance(document, os.PathLike):
+        return display_path(document)
+    if isinstance(document, str) and any("\udc80" <= c <= "\udcff" for c in document):
+        return display_path(document)
+    return document
+
+
+def print_json(document) -> None:
+    """Print a command's ``--json`` document, one line on stdout (:func:`displayed_names`)."""
+    import json
+
+    print(json.dumps(displayed_names(document)))
+
+
 def add_json_option(p: argparse.ArgumentParser, *, progress: bool = False) -> None:
     """``--json`` (one JSON document on stdout) and, with ``progress``, ``--no-progress``."""
     p.add_argument("--json", action="store_true", help="one JSON document on stdout")

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 from pathlib import Path
@@ -22,6 +21,7 @@ from ._options import (
     analysis_options,
     given_options,
     path_argument,
+    print_json,
     progress_wanted,
 )
 from ._vocabulary import cli_words
@@ -165,22 +165,21 @@ def _print_results(args: argparse.Namespace, results: list, cases: list, stated:
     said_assumed = [[cli_words(n) for n in assumption_notes(display_path(Path(path).name), a)]
                     for path, a in zip(args.paths, assumptions, strict=True)]
     if args.json:
-        json.dump({"records": [{**r.to_dict(),
-                                "notes": [*(cli_words(n) for n in r.notes), *words],
-                                "load_case": c.key if c else None,
-                                "specimen": fs.specimen or None,
-                                "specimen_sha256": fs.specimen_sha256 or None,
-                                "assumed": a,
-                                "parameters": fs.options.parameters(),
-                                "settings_from": dict(fs.sources),
-                                "overridden": said,
-                                "sidecar_row_missing": fs.unmatched or None}
-                               for r, c, said, fs, a, words in zip(
-                                   results, cases, overridden, settings, assumptions,
-                                   said_assumed, strict=True)],
-                   "notes": [*overrides, *replaced,
-                             *([f"saved {breakdown}"] if breakdown else [])]}, sys.stdout)
-        sys.stdout.write("\n")
+        print_json({"records": [{**r.to_dict(),
+                                 "notes": [*(cli_words(n) for n in r.notes), *words],
+                                 "load_case": c.key if c else None,
+                                 "specimen": fs.specimen or None,
+                                 "specimen_sha256": fs.specimen_sha256 or None,
+                                 "assumed": a,
+                                 "parameters": fs.options.parameters(),
+                                 "settings_from": dict(fs.sources),
+                                 "overridden": said,
+                                 "sidecar_row_missing": fs.unmatched or None}
+                                for r, c, said, fs, a, words in zip(
+                                    results, cases, overridden, settings, assumptions,
+                                    said_assumed, strict=True)],
+                    "notes": [*overrides, *replaced,
+                              *([f"saved {breakdown}"] if breakdown else [])]})
         return
     print(format_table(results))
     for path, c, st, fs in zip(args.paths, cases, stated, settings, strict=True):

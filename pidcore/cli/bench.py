@@ -3,9 +3,8 @@
 from __future__ import annotations
 
 import argparse
-import json
 
-from ._options import positive_int, progress_wanted
+from ._options import positive_int, print_json, progress_wanted
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -77,7 +76,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def _emit(result: dict, as_json: bool) -> None:
     if as_json:
-        print(json.dumps(result))
+        print_json(result)
         return
     width = max(len(k) for k in result)
     for key, value in result.items():

@@ -11,6 +11,7 @@ from ._options import (
     check_out_folder,
     comma_list,
     command_line,
+    displayed_names,
     non_negative_int,
     path_argument,
     positive_int,
@@ -189,7 +190,7 @@ def _print_result(args: argparse.Namespace, result, own_notes: list[str], saved:
             f"from {args.dem_store}" + (f" ({specimens})" if specimens else ""))
     if args.json:
         print(f"pidcore calibrate: note: {runs}", file=sys.stderr)
-        print(document_json(result.document()))
+        print(document_json(displayed_names(result.document())))
         print(f"pidcore calibrate: {said}", file=sys.stderr)
     else:
         from ..calibrate.outputs import file_prediction_rows, parameter_units, specimen_words

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 
@@ -26,6 +25,7 @@ from ._options import (
     non_negative_int,
     path_argument,
     positive_int,
+    print_json,
     progress_wanted,
     scheduler_address,
 )
@@ -312,7 +312,7 @@ def _print_sweep(args: argparse.Namespace, summary) -> None:
     states them) and how its run was got, the counts, the cases it found to be the same
     simulation as another, and its runs' notes."""
     if args.json:
-        print(json.dumps(summary.to_dict()))
+        print_json(summary.to_dict())
     else:
         from ..dem.sweep import STORED_MEANWHILE
 
@@ -476,7 +476,7 @@ def _print_run(args: argparse.Namespace, result, case, specimen, *, key: str | N
         if key is not None:
             out["store_key"] = key
             out["reused_from_store"] = reused
-        print(json.dumps(out))
+        print_json(out)
         return
     print(format_summary(result, reused=reused))
     total = _measured_sdc_line(specimen, result)

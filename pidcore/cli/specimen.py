@@ -5,12 +5,11 @@ nothing needs."""
 from __future__ import annotations
 
 import argparse
-import json
 from typing import TYPE_CHECKING
 
 from .. import defaults
 from ..constants import NORMAL_DAMPING_MODES
-from ._options import add_json_option, add_store_option, path_argument
+from ._options import add_json_option, add_store_option, path_argument, print_json
 from ._vocabulary import cli_words
 
 if TYPE_CHECKING:
@@ -79,7 +78,7 @@ def run_check(args: argparse.Namespace) -> int:
     facts = describe(specimen, damping_mode=args.damping_mode)
     facts["notes"] = [cli_words(note, "specimen check") for note in facts["notes"]]
     if args.json:
-        print(json.dumps(facts))
+        print_json(facts)
         return 0
     # the file read: a bundled specimen named by its name alone is read from site-packages
     print(format_facts(facts, specimen.source))
@@ -92,7 +91,7 @@ def run_kept(args: argparse.Namespace) -> int:
     found = prune_kept_specimens(args.store, remove=args.remove, only=args.files,
                                  recent_hours=args.keep_recent_hours)
     if args.json:
-        print(json.dumps(found.to_dict()))
+        print_json(found.to_dict())
         return 0
     print(format_kept(found))
     return 0

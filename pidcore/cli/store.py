@@ -14,6 +14,7 @@ from ._options import (
     add_json_option,
     add_store_option,
     command_line,
+    print_json,
     progress_wanted,
 )
 
@@ -83,9 +84,9 @@ def run_list(args: argparse.Namespace) -> int:
 
     contents = store_contents(args.store, args.section or list(SECTIONS))
     if args.json:
-        print(json.dumps({"store": str(args.store), **{
+        print_json({"store": args.store, **{
             section: json.loads(frame.to_json(orient="records"))
-            for section, frame in contents.items()}}))
+            for section, frame in contents.items()}})
         return 0
     blocks = [f"{section} ({len(frame)}):\n" + (_table(frame) if len(frame) else "  none")
               for section, frame in contents.items()]
@@ -129,8 +130,8 @@ def run_verify(args: argparse.Namespace) -> int:
     except StoreError:  # a store too damaged to say: its problems are printed
         unchecked = []
     if args.json:
-        print(json.dumps({"store": str(args.store), "sound": not problems,
-                          "problems": problems, "unchecked": unchecked, "summary": summary}))
+        print_json({"store": args.store, "sound": not problems,
+                          "problems": problems, "unchecked": unchecked, "summary": summary})
     elif problems:
         print("\n".join(problems))
         print(f"{args.store}: damaged: {len(problems)} problem(s)", file=sys.stderr)
@@ -150,7 +151,7 @@ def run_remove(args: argparse.Namespace) -> int:
     removal = remove_records(args.store, args.keys, with_dependents=args.with_dependents,
                              dry_run=args.dry_run)
     if args.json:
-        print(json.dumps(removal.to_dict()))
+        print_json(removal.to_dict())
         return 0
     print(format_removal(removal))
     return 0
