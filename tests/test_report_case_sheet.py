@@ -188,6 +188,30 @@ def test_a_case_sheet_without_a_calibration_gives_no_calibrated_verdict(tmp_path
         assert "95 % band" not in text and CALIBRATED_INSIDE_COLUMN not in text
 
 
+def test_a_case_sheet_refuses_a_dem_run_whose_sdc_no_run_saves_naming_store_and_run(tmp_path):
+    # the page lists the runs once (the app keeps its listing) and reads the case's run for
+    # its loop when it draws the sheet: a run damaged in between (SDC -0.5) was drawn as ours
+    import shutil
+
+    import h5py
+
+    from pidcore.errors import StoreError
+    from pidcore.report import case_view as views
+    from pidcore.store.listing import list_dem_runs
+
+    store = _store(tmp_path, 0.0)
+    dem = tmp_path / "dem.h5"
+    shutil.copyfile(DEM_STORE, dem)
+    members, view = _compare_view(store)
+    runs = list_dem_runs(store, dem)
+    (key, *_) = view["comparison"].aligned.grid_case.run_keys
+    with h5py.File(dem, "r+") as h5:
+        h5[f"dem_runs/{key}/record"].attrs["sdc"] = -0.5
+    with pytest.raises(StoreError, match=f"dem.h5: DEM run {key}: record field sdc = -0.5 is "
+                                         "not a finite number >= 0"):
+        views.case_view(members, runs, load_paper_table3(), (store, dem))
+
+
 @pytest.mark.usefixtures("undrawn_report_figures")
 def test_a_case_sheet_of_a_case_the_calibration_does_not_predict_gives_no_verdict(
         tmp_path, monkeypatch):

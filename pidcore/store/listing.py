@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -78,8 +79,9 @@ def analysis_row_problems(row: pd.Series) -> list[str]:
     return problems
 
 
-def dem_run_row_problems(row: pd.Series) -> list[str]:
-    """What a stored DEM run's result fields (a row of :meth:`Store.list_dem_runs`) hold that
+def dem_run_row_problems(row: pd.Series | Mapping[str, object]) -> list[str]:
+    """What a stored DEM run's result fields (a row of :meth:`Store.list_dem_runs`, or a
+    record with its case_key as :meth:`Store.get_dem_run` checks it) hold that
     no run saves: an SDC that is not a finite number >= 0 (a run's is its dissipation over
     the peak kinetic energy), or one other than 2 pi x its loss factor or its
     energy_per_cycle_j / max_kinetic_energy_j (:meth:`pidcore.dem.result.DemResult.
@@ -116,7 +118,8 @@ def checked_dem_runs(runs: pd.DataFrame, where: str | os.PathLike) -> pd.DataFra
     return runs
 
 
-def damaged_dem_run(where: str | os.PathLike, row: pd.Series, what: str) -> StoreError:
+def damaged_dem_run(where: str | os.PathLike, row: pd.Series | Mapping[str, object],
+                    what: str) -> StoreError:
     """The refusal of a DEM run changed outside pidcore, naming the store and the run."""
     return StoreError(f"{where}: DEM run {row.get('case_key', '')}: {what}; it was changed or "
                       "damaged outside pidcore (run it again into a fresh store)")

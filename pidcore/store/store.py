@@ -1085,8 +1085,20 @@ class Store:
             return self._stored_entry(h5, _DEM_RUNS, case_key) is not None
 
     def get_dem_run(self, case_key: str) -> StoredEntry:
-        """The DEM run stored under ``case_key``."""
-        return self._get_entry(_DEM_RUNS, case_key, "DEM run", key_name="DEM case key")
+        """The DEM run stored under ``case_key``; one whose SDC no run saves (negative, NaN,
+        not 2 pi x its loss factor: :func:`pidcore.store.listing.dem_run_row_problems`) is
+        refused naming the store and the run. Every reader of a run for use passes here
+        (calibrate's reuse and observations, a case sheet's loop, re-keying): an SDC of -0.5
+        reached a calibration and a case sheet, checked by the listings only. verify reads
+        entries on its own and names such a run rather than stopping at it."""
+        from .listing import damaged_dem_run, dem_run_row_problems
+
+        entry = self._get_entry(_DEM_RUNS, case_key, "DEM run", key_name="DEM case key")
+        row = {**entry.record, "case_key": case_key}
+        problems = dem_run_row_problems(row)
+        if problems:
+            raise damaged_dem_run(self.path, row, problems[0])
+        return entry
 
     def list_dem_runs(self) -> pd.DataFrame:
         """One row per DEM run: case_key, created_utc, every scalar field, parameters_json,
