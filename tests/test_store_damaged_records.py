@@ -131,6 +131,13 @@ _SCHEMA_EDITS = {
                                            data=np.array([0.4])),
                        "array sdc_per_cell has 1 elements along cells_simulated; expected 2",
                        False),
+    # no run writes a NaN or inf in its tallies or record: one set there passed verify
+    "NaN force sample": (lambda h5: h5[f"{_RUN}/arrays/wall_force_n"].__setitem__(3, np.nan),
+                         "array wall_force_n holds 1 non-finite value(s) (NaN/inf), first at "
+                         "flat index 3", False),
+    "infinite cell SDC": (lambda h5: h5[f"{_RUN}/arrays/sdc_per_cell"].__setitem__(0, np.inf),
+                          "array sdc_per_cell holds 1 non-finite value(s) (NaN/inf), first at "
+                          "flat index 0", False),
 }
 
 
@@ -181,6 +188,25 @@ def test_an_analysis_whose_harmonics_are_text_is_refused_by_verify_and_report(
     rc = main(["report", "--store", str(store), "--out", str(tmp_path / "report")])
     err = capsys.readouterr().err.strip()
     assert rc == 2 and len(err.splitlines()) == 1 and "array harmonics" in err
+
+
+def test_an_analysis_whose_phasor_is_nan_is_damage_verify_names_and_report_refuses(
+        analysed_store, tmp_path, capsys):
+    from pidcore.store import Store
+
+    store = tmp_path / "store.h5"
+    store.write_bytes(analysed_store.read_bytes())
+    with h5py.File(store, "r+") as h5:
+        (entry,) = h5["analyses"].values()
+        entry["arrays/velocity_phasors_m_s"][1] = complex(np.nan, 0.0)
+        key = entry.name
+    (problem,) = Store(store).verify()
+    assert f"{store}:{key}" in problem
+    assert "array velocity_phasors_m_s holds 1 non-finite value(s) (NaN/inf), first at flat " \
+           "index 1" in problem
+    rc = main(["report", "--store", str(store), "--out", str(tmp_path / "report")])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and len(err.splitlines()) == 1 and "array velocity_phasors_m_s" in err
 
 
 def test_a_stored_text_longer_than_any_name_is_refused_where_written_and_where_read(tmp_path):

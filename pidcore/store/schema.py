@@ -41,6 +41,12 @@ _DIMENSIONS: dict[str, dict[str, tuple[str, ...]]] = {
 }
 #: Arrays that hold complex phasors (every other is real).
 _COMPLEX_ARRAYS = frozenset({"force_phasors_n", "velocity_phasors_m_s"})
+#: Arrays whose every value is finite as pidcore writes them: an analysis's phasors are fits
+#: of samples it refuses unless finite, a DEM run's arrays are its tallies and virtual shaker
+#: record (sdc_per_cell is NaN only where the run's SDC is, refused on its own). A NaN set in
+#: one passed verify and was drawn or summed over. Measurement samples are not among them: a
+#: channel no analysis used (or a gap an analysis refuses) is stored as read, NaN and all.
+_FINITE_ARRAYS = frozenset(name for dims in _DIMENSIONS.values() for name in dims)
 _DIMENSIONLESS = frozenset({COUNT_UNIT, RATIO_UNIT})
 #: Fields whose unit must be stated where an entry states any: the result itself, which every
 #: report and calibration compares (a caller of the API states its own fields' units as it
@@ -122,6 +128,11 @@ def array_problems(layout: str, record: Mapping[str, object], arrays: Mapping[st
             problems.append(f"array {name} holds {what}; expected {a_or_an(expected)} "
                             "array")
             continue
+        if name in _FINITE_ARRAYS and array.size and not np.all(np.isfinite(array)):
+            bad = ~np.isfinite(array.ravel())
+            problems.append(f"array {name} holds {int(bad.sum())} non-finite value(s) (NaN/inf), "
+                            f"first at flat index {int(np.argmax(bad))}; expected finite "
+                            "numbers, as pidcore writes them")
         unit = array_units.get(name, "")
         if unit and not _same_unit(unit, schema[name]):
             problems.append(f"array {name} states unit {unit!r}; expected {schema[name]!r}")
