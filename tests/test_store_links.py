@@ -34,8 +34,33 @@ def test_a_soft_link_to_a_root_link_to_another_file_is_never_followed(tmp_path):
     with pytest.raises(StoreError, match=r"s\.h5: not a readable pidcore store \(/zz_ext is an "
                                          r"external link to '.*secret\.h5'"):
         store.get_dem_run("a")
-    (problem,) = store.verify()
-    assert "/zz_ext is an external link" in problem
+    # both named, each once: the root link, and the record's soft link to it
+    (root, record) = store.verify()
+    assert "s.h5: /zz_ext is an external link" in root
+    assert "dem_runs/a" in record and "soft link to '/zz_ext'" in record
+
+
+@pytest.mark.parametrize("name", ["zz", "measurements"])
+def test_store_verify_names_a_root_external_link_as_damage_and_exits_1(tmp_path, capsys, name):
+    # it said 'not a readable pidcore store' and exited 2, as for a file that is no store;
+    # every read still refuses it, and the link is never followed
+    from pidcore.cli import main
+
+    store = _runs(tmp_path)
+    with h5py.File(store.path, "r+") as h5:
+        if name in h5:
+            del h5[name]
+        h5[name] = h5py.ExternalLink("/etc/passwd", "/")
+    capsys.readouterr()
+    assert main(["store", "verify", "--store", str(store.path)]) == 1
+    out = capsys.readouterr().out.strip()
+    assert out == (f"{store.path}: /{name} is an external link to '/etc/passwd'; expected the "
+                   "store's own groups at its root (measurements, analyses, dem_runs, "
+                   "calibrations)")
+    with pytest.raises(StoreError, match=f"not a readable pidcore store \\(/{name} is an "
+                                         "external link"):
+        store.get_dem_run("a")
+    assert main(["store", "list", "--store", str(store.path)]) == 2
 
 
 @pytest.mark.parametrize("link", ["arrays/velocity_m_s", "record"])

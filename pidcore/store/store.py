@@ -447,8 +447,10 @@ class Store:
                                      "(too many levels of links); expected a store file or a "
                                      "link to one") from None
         if self.path.exists():
-            with self._reading():
-                pass  # refuse a corrupt or foreign file now rather than at first use
+            # refuse a corrupt or foreign file now rather than at first use; a link at its
+            # root is refused by every read and write, and named by verify as damage
+            with self._reading(root_links=False):
+                pass
 
     def __repr__(self) -> str:
         return f"Store({str(self.path)!r})"
@@ -571,8 +573,10 @@ class Store:
                               "try again")
         return StoreError(f"{self.path}: not a readable pidcore store ({said})")
 
-    def _check_root(self, h5: h5py.File, *, every_entry: bool = True) -> None:
-        """Refuse a file that is not a store of a version this pidcore reads, and, with
+    def _check_root(self, h5: h5py.File, *, every_entry: bool = True,
+                    root_links: bool = True) -> None:
+        """Refuse a file that is not a store of a version this pidcore reads, with
+        ``root_links`` one with a link at its root (:meth:`_root_links`), and, with
         ``every_entry``, a foreign layout anywhere in its sections (:meth:`_check_sections`)."""
         version = h5.attrs.get("pidcore_store_version")
         if version is None:
@@ -593,23 +597,30 @@ class Store:
             raise StoreError(f"{self.path}: store version {version} is newer than this pidcore "
                              f"({__version__}) understands (version {STORE_VERSION}); "
                              "upgrade pidcore")
-        for name in h5:
-            # a link at the root leads out of the store's own objects (/zz = an external link
-            # that an entry's soft link pointed at), whatever its name
-            link = h5.get(name, getlink=True)
-            if not isinstance(link, h5py.HardLink):
-                raise self._unreadable(f"/{name} is {self._what(link, None)}; expected the "
-                                       f"store's own groups at its root ({', '.join(_SECTIONS)})")
-        if every_entry:
-            self._check_sections(h5)
+        links = self._root_links(h5)
+        if links and root_links:
+            raise self._unreadable(next(iter(links.values())))
+        if every_entry:  # a section that is a link is not followed
+            self._check_sections(h5, skip=links)
 
-    def _check_sections(self, h5: h5py.File) -> None:
+    def _root_links(self, h5: h5py.File) -> dict[str, str]:
+        """``{name: what is wrong}`` of each link at the root: one leads out of the store's own
+        objects (/zz = an external link that an entry's soft link pointed at), whatever its
+        name. Every read refuses the store; verify names each as damage (exit 1) and checks
+        the rest, as it does a link inside a record: it said 'not a readable pidcore store'
+        (exit 2, as for a file that is none)."""
+        return {name: f"/{name} is {self._what(link, None)}; expected the store's own groups "
+                      f"at its root ({', '.join(_SECTIONS)})"
+                for name in h5 if not isinstance(link := h5.get(name, getlink=True),
+                                                 h5py.HardLink)}
+
+    def _check_sections(self, h5: h5py.File, skip: Iterable[str] = ()) -> None:
         """Refuse a foreign layout before anything reads or copies it: each section a group of
         the file itself, each entry a group of the file itself (an external link would make
         every listing open another file on the machine; a soft link to nothing, a dataset
         where a group belongs, crashed every listing and every write)."""
         for section in _SECTIONS:
-            parent = self._section(h5, section)
+            parent = None if section in skip else self._section(h5, section)
             for name in () if parent is None else parent:
                 self._entry_of(parent, section, name)
 
@@ -653,7 +664,8 @@ class Store:
         return item
 
     @contextmanager
-    def _reading(self, *, every_entry: bool = True) -> Iterator[h5py.File | None]:
+    def _reading(self, *, every_entry: bool = True,
+                 root_links: bool = True) -> Iterator[h5py.File | None]:
         """Open the committed store read-only (``None`` when it does not exist yet).
 
         ``every_entry=False`` is for reading a few entries by key: their links are checked
@@ -677,7 +689,7 @@ class Store:
         except OSError as exc:
             raise self._unreadable(exc) from None
         try:
-            self._check_root(h5, every_entry=every_entry)
+            self._check_root(h5, every_entry=every_entry, root_links=root_links)
             yield h5
         except (OSError, RuntimeError) as exc:
             # h5py reports damaged objects inside an openable file as OSError/RuntimeError.
@@ -1367,14 +1379,17 @@ class Store:
         problems: list[str] = []
         try:
             try:
-                self._check_root(h5)
+                self._check_root(h5, root_links=False)
             except StoreError as exc:
                 return [str(exc)]
+            links = self._root_links(h5)  # damage named; the sections linked are not read
+            problems += [f"{self.path}: {said}" for said in links.values()]
             problems += [f"{self.path}: root attribute {name} missing"
                          for name in _ROOT_ATTRS if name not in h5.attrs]
-            total = sum(len(h5[section]) for section in _SECTIONS if section in h5)
+            sections = [section for section in _SECTIONS if section not in links]
+            total = sum(len(h5[section]) for section in sections if section in h5)
             done = 0
-            for section in _SECTIONS:
+            for section in sections:
                 if section not in h5:
                     if section == _CALIBRATIONS:
                         continue  # written before calibrations were stored: not damage
@@ -1518,7 +1533,9 @@ class Store:
     def summary(self) -> dict[str, Any]:
         """Counts and identity of the store: path, exists, store_version, created_utc,
         n_measurements, n_analyses, n_dem_runs, n_calibrations, size_bytes."""
-        with self._reading() as h5:
+        # counts of the sections of the store's own file only, a link at the root not
+        # followed: verify's summary of a store it names such a link in
+        with self._reading(every_entry=False, root_links=False) as h5:
             if h5 is None:
                 return {"path": str(self.path), "exists": False, "store_version": None,
                         "created_utc": None, "n_measurements": 0, "n_analyses": 0,
@@ -1528,9 +1545,17 @@ class Store:
                 "exists": True,
                 "store_version": int(from_attribute(h5.attrs["pidcore_store_version"])),
                 "created_utc": _text(h5.attrs.get("created_utc", "")),
-                "n_measurements": len(h5.get(_MEASUREMENTS, {})),
-                "n_analyses": len(h5.get(_ANALYSES, {})),
-                "n_dem_runs": len(h5.get(_DEM_RUNS, {})),
-                "n_calibrations": len(h5.get(_CALIBRATIONS, {})),
+                "n_measurements": self._count(h5, _MEASUREMENTS),
+                "n_analyses": self._count(h5, _ANALYSES),
+                "n_dem_runs": self._count(h5, _DEM_RUNS),
+                "n_calibrations": self._count(h5, _CALIBRATIONS),
                 "size_bytes": self.path.stat().st_size,
             }
+
+    @staticmethod
+    def _count(h5: h5py.File, section: str) -> int:
+        """Entries of ``section``: 0 where it is absent or no group of the store's own file
+        (a link, never followed)."""
+        link = h5.get(section, getlink=True)
+        group = h5.get(section) if isinstance(link, h5py.HardLink) else None
+        return len(group) if isinstance(group, h5py.Group) else 0
