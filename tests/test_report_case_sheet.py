@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import re
 import zlib
 from pathlib import Path
@@ -461,8 +462,11 @@ def _own_specimen(tmp_path):
     path = tmp_path / "own.toml"
     path.write_text(own.to_toml(), encoding="utf-8")
     run = Store(DEM_STORE).get_dem_run(GRID_RUN)
-    record = {**run.record, "sdc": OWN_RUN_SDC, "specimen_name": own.name,
-              "specimen_sha256": own.hash, "specimen_is_paper": 0}
+    # its loss factor and energy per cycle as a run of that SDC saves them: a run whose SDC
+    # is not 2 pi x its loss factor is refused as damaged
+    record = {**run.record, "sdc": OWN_RUN_SDC, "loss_factor": OWN_RUN_SDC / (2 * math.pi),
+              "energy_per_cycle_j": OWN_RUN_SDC * run.record["max_kinetic_energy_j"],
+              "specimen_name": own.name, "specimen_sha256": own.hash, "specimen_is_paper": 0}
     parameters = {**run.parameters, "specimen_text": own.text, "specimen_sha256": own.hash,
                   "specimen_name": own.name}
     store = tmp_path / "own_runs.h5"
