@@ -132,7 +132,8 @@ def test_a_specimen_file_nested_past_the_stack_is_one_line(tmp_path, capsys):
 
     deep = tmp_path / "deep.toml"
     deep.write_text("a = " + "[" * 100_000)
-    code = main(["dem", "run", "--specimen", str(deep), "--freq", "500", "--accel", "5"])
+    code = main(["dem", "run", "--specimen", str(deep), "--frequency", "500",
+                 "--acceleration", "5"])
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1 and str(deep) in err, err
     assert "nested too deeply" in err
