@@ -107,14 +107,20 @@ def dem_run_row_problems(row: pd.Series | Mapping[str, object]) -> list[str]:
     return problems
 
 
+def check_dem_run(where: str | os.PathLike, row: pd.Series | Mapping[str, object]) -> None:
+    """:class:`StoreError` naming the store ``where``, the run and the field where a DEM run's
+    result fields (``row``, with its case_key) hold what no run saves
+    (:func:`dem_run_row_problems`)."""
+    problems = dem_run_row_problems(row)
+    if problems:
+        raise damaged_dem_run(where, row, problems[0])
+
+
 def checked_dem_runs(runs: pd.DataFrame, where: str | os.PathLike) -> pd.DataFrame:
     """``runs`` (a :meth:`Store.list_dem_runs` listing of the store ``where``) if every run's
-    result fields hold what a run saves (:func:`dem_run_row_problems`), else
-    :class:`StoreError` naming the store, the run and the field."""
+    result fields hold what a run saves, else :class:`StoreError` (:func:`check_dem_run`)."""
     for _, row in runs.iterrows():
-        problems = dem_run_row_problems(row)
-        if problems:
-            raise damaged_dem_run(where, row, problems[0])
+        check_dem_run(where, row)
     return runs
 
 

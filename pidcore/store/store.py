@@ -1103,13 +1103,10 @@ class Store:
         (calibrate's reuse and observations, a case sheet's loop, re-keying): an SDC of -0.5
         reached a calibration and a case sheet, checked by the listings only. verify reads
         entries on its own and names such a run rather than stopping at it."""
-        from .listing import damaged_dem_run, dem_run_row_problems
+        from .listing import check_dem_run
 
         entry = self._get_entry(_DEM_RUNS, case_key, "DEM run", key_name="DEM case key")
-        row = {**entry.record, "case_key": case_key}
-        problems = dem_run_row_problems(row)
-        if problems:
-            raise damaged_dem_run(self.path, row, problems[0])
+        check_dem_run(self.path, {**entry.record, "case_key": case_key})
         return entry
 
     def list_dem_runs(self) -> pd.DataFrame:
@@ -1419,30 +1416,31 @@ class Store:
     def _analysis_values(self) -> list[str]:
         """Analyses whose result fields hold what no analysis saves (an SDC of NaN or not
         2 pi x its loss factor, a negative frequency): refused by report and calibrate
-        (:func:`pidcore.store.listing.analysis_row_problems`), called sound here before.
-        Not checked where the listing cannot be read: the entries' own problems are said
-        above."""
+        (:func:`pidcore.store.listing.analysis_row_problems`), called sound here before."""
         from .listing import analysis_row_problems, damaged_analysis
 
-        try:
-            analyses = self.list_analyses()
-        except StoreError:
-            return []
-        return [str(damaged_analysis(self.path, row, problem))
-                for _, row in analyses.iterrows() for problem in analysis_row_problems(row)]
+        return self._row_values(self.list_analyses, analysis_row_problems, damaged_analysis)
 
     def _dem_run_values(self) -> list[str]:
         """DEM runs whose SDC is no result a run saves (negative, NaN, not 2 pi x its loss
         factor nor its energy per cycle over its peak kinetic energy), refused by reports
-        (:func:`pidcore.store.listing.dem_run_row_problems`); as :meth:`_analysis_values`."""
+        (:func:`pidcore.store.listing.dem_run_row_problems`)."""
         from .listing import damaged_dem_run, dem_run_row_problems
 
+        return self._row_values(self.list_dem_runs, dem_run_row_problems, damaged_dem_run)
+
+    def _row_values(self, listing: Callable[[], pd.DataFrame],
+                    problems_of: Callable[[pd.Series], list[str]],
+                    damaged: Callable[[Path, pd.Series, str], StoreError]) -> list[str]:
+        """Each problem ``problems_of`` finds in a row of ``listing``, as ``damaged`` says it.
+        Not checked where the listing cannot be read: the entries' own problems are said by
+        :meth:`verify` before."""
         try:
-            runs = self.list_dem_runs()
+            rows = listing()
         except StoreError:
             return []
-        return [str(damaged_dem_run(self.path, row, problem))
-                for _, row in runs.iterrows() for problem in dem_run_row_problems(row)]
+        return [str(damaged(self.path, row, problem))
+                for _, row in rows.iterrows() for problem in problems_of(row)]
 
     def _missing_design_runs(self) -> list[str]:
         """A calibration whose design runs were removed without it (a run shared by two
