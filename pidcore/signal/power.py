@@ -519,6 +519,22 @@ def _quantity_slip_cause(p_c: complex, motion_name: str, *, motion_is_velocity: 
             f"{expected}, probably holds {slips} (check the column's quantity and unit)")
 
 
+def _shortest_block(edges: np.ndarray, n_blocks: int) -> int:
+    """Samples in the shortest of the ``n_blocks`` blocks of the standard error."""
+    return int(np.min(np.diff(edges[:n_blocks + 1])))
+
+
+def _noise_judges(fit: HarmonicFit, n_blocks: int, edges: np.ndarray) -> bool:
+    """Whether the blocks' residuals hold the :data:`~pidcore.defaults.DRIVE_PHASE_MIN_DOF`
+    spare samples their noise estimate needs to judge a block's phasor by. A block a few
+    samples longer than the fit's parameters has none (one period of 12.8 samples at 12
+    parameters leaves under 1 degree of freedom, and the near-saturated fit multiplies its
+    noise): a steady drive at 20 dB was refused as a sweep there half the time; the checks
+    that judge blocks by their noise say nothing there."""
+    spare = _shortest_block(edges, n_blocks) - fit_parameter_count(fit.phasors.shape[2])
+    return spare >= defaults.DRIVE_PHASE_MIN_DOF
+
+
 def _check_stationary_drive(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
                             motion: np.ndarray, sample_rate_hz: float, frequency_hz: float, *,
                             what: str, noise_of_quietest_block: bool = False) -> str:
@@ -545,12 +561,7 @@ def _check_stationary_drive(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
     loss = 1.0 - float(abs(np.mean(fundamentals))) / mean_amplitude
     if loss <= defaults.DRIVE_COHERENCE_NOTED_LOSS:
         return ""
-    n_params = fit_parameter_count(fit.phasors.shape[2])
-    # a block a few samples longer than the fit's parameters has no noise estimate to judge
-    # its phase by (one period of 12.8 samples at 12 parameters leaves under 1 degree of
-    # freedom, and the near-saturated fit multiplies its noise): a steady drive at 20 dB was
-    # refused as a sweep there half the time; the check says nothing
-    if int(np.min(np.diff(edges[:n_blocks + 1]))) - n_params < defaults.DRIVE_PHASE_MIN_DOF:
+    if not _noise_judges(fit, n_blocks, edges):
         return ""
     scatter = fit.fundamental_variance[1, :n_blocks] / amplitudes ** 2
     # the median: a block the drive has left (a fast sweep) holds its power in its residual
@@ -561,7 +572,7 @@ def _check_stationary_drive(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
     moved = (f"the drive line's phase spans {np.ptp(phases):.3g} degrees over the "
              f"{fundamentals.size} blocks of the record")
     # a block's own frequency is known where it holds as many periods as a record must
-    block_periods = int(np.min(np.diff(edges[:n_blocks + 1]))) * frequency_hz / sample_rate_hz
+    block_periods = _shortest_block(edges, n_blocks) * frequency_hz / sample_rate_hz
     if block_periods >= defaults.MIN_PERIODS:
         # each block's line found in its own spectrum: refined from the record's frequency, a
         # block a wide sweep had carried far from it settled on a wrong line (597.9 Hz for
@@ -606,10 +617,7 @@ def _check_block_amplitudes(fit: HarmonicFit, n_blocks: int, edges: np.ndarray,
     median block's noise: a beat or a slow ramp moves every block and none stands out. The
     record's fit, about the blocks' mean, then departs from the steady blocks by the out
     blocks' departures over the block count, which is what the message says."""
-    spare = int(np.min(np.diff(edges[:n_blocks + 1]))) - fit_parameter_count(
-        fit.phasors.shape[2])
-    # the noise of a block with fewer spare samples is no yardstick (see the phase check)
-    if n_blocks < defaults.BLOCK_AMPLITUDE_MIN_BLOCKS or spare < defaults.DRIVE_PHASE_MIN_DOF:
+    if n_blocks < defaults.BLOCK_AMPLITUDE_MIN_BLOCKS or not _noise_judges(fit, n_blocks, edges):
         return ""
     said = []
     worst = 0.0
@@ -840,7 +848,7 @@ def analyze_power(force: np.ndarray, velocity: np.ndarray | None, sample_rate_hz
         uncertainty_note = ""
         # a block of fewer samples than the fit's parameters (harmonics, DC and trend) has no
         # phasors (NaN): one period of 11.6 samples at 5 harmonics holds 11 for 12
-        shortest = int(np.min(np.diff(edges)))
+        shortest = _shortest_block(edges, k_blocks)
         n_params = fit_parameter_count(n_harm)
         if shortest < n_params:
             edges = np.array([0, n_samples], dtype=np.int64)
